@@ -1,0 +1,21 @@
+# Cross build for 64-bit ARM Linux boards (Raspberry Pi 4/5, i.MX8, RK3399 ...) with Debian's
+# g++-aarch64-linux-gnu. Test executables run under qemu-user: binfmt_misc is often not mounted
+# in containers, so the emulator is always named explicitly.
+set(CMAKE_SYSTEM_NAME Linux)
+set(CMAKE_SYSTEM_PROCESSOR aarch64)
+
+set(CMAKE_C_COMPILER aarch64-linux-gnu-gcc)
+set(CMAKE_CXX_COMPILER aarch64-linux-gnu-g++)
+set(CMAKE_LIBRARY_ARCHITECTURE aarch64-linux-gnu)
+
+set(CMAKE_FIND_ROOT_PATH /usr/aarch64-linux-gnu)
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE BOTH)
+set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE BOTH)
+
+set(CMAKE_CROSSCOMPILING_EMULATOR /usr/bin/qemu-aarch64-static;-L;/usr/aarch64-linux-gnu)
+
+# Used by the integer-only check of the per-frame objects (tests/static).
+set(SMX_TARGET_OBJDUMP aarch64-linux-gnu-objdump)
+set(SMX_TARGET_NM aarch64-linux-gnu-nm)
