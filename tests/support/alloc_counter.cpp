@@ -27,7 +27,10 @@ std::uint64_t bytesAllocatedSoFar() { return gBytes.load(std::memory_order_relax
 
 #if defined(SMX_ALLOC_COUNTER_SANITIZER_HOOKS)
 
-#include <sanitizer/allocator_interface.h>
+// Declared here: GCC's sanitizer runtime exports it, but Debian's GCC ships no
+// <sanitizer/allocator_interface.h>.
+extern "C" int __sanitizer_install_malloc_and_free_hooks(  // NOLINT(bugprone-reserved-identifier)
+    void (*mallocHook)(const volatile void*, std::size_t), void (*freeHook)(const volatile void*));
 
 namespace {
 

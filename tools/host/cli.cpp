@@ -1,0 +1,33 @@
+#include "cli.hpp"
+
+#include <vector>
+
+#include "commands.hpp"
+
+namespace smx::host {
+
+int runCli(std::span<const std::string> args, const CliStreams& io) {
+  CLI::App app{"stripemux — multi-projector colour structured-light 3D scanner tool", "stripemux"};
+  app.set_version_flag("--version", "stripemux " SMX_VERSION);
+  app.require_subcommand(0, 1);
+
+  int exitCode = kExitOk;
+  addPatternCommand(app, io, exitCode);
+
+  std::vector<const char*> argv{"stripemux"};
+  for (const auto& a : args) {
+    argv.push_back(a.c_str());
+  }
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, io.out, io.err);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  if (app.get_subcommands().empty()) {
+    io.out << app.help();
+  }
+  return exitCode;
+}
+
+}  // namespace smx::host

@@ -1,0 +1,12 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "cli.hpp"
+
+// Each subcommand registers itself on the app; when selected, its callback stores its exit code.
+namespace smx::host {
+
+void addPatternCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+
+}  // namespace smx::host

@@ -1,0 +1,63 @@
+#include "png_io.hpp"
+
+#include <png.h>
+
+#include <cstring>
+#include <memory>
+
+namespace smx::host {
+namespace {
+
+// png_image owns libpng state until finished or freed; free it on every exit path.
+struct ImageGuard {
+  png_image& image;
+  ~ImageGuard() { png_image_free(&image); }
+};
+
+std::string describe(const std::filesystem::path& path, const png_image& image) {
+  return path.string() + ": " + image.message;
+}
+
+}  // namespace
+
+std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
+                                              algo::ConstRgbView image) {
+  // libpng wants rows whose stride is a whole number of pixels: pack padded views first.
+  std::vector<algo::Rgb8> packed(static_cast<std::size_t>(image.width()) *
+                                 static_cast<std::size_t>(image.height()));
+  for (int y = 0; y < image.height(); ++y) {
+    const auto row = image.row(y);
+    std::memcpy(packed.data() + static_cast<std::size_t>(y) * row.size(), row.data(),
+                row.size_bytes());
+  }
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(image.width());
+  png.height = static_cast<png_uint_32>(image.height());
+  png.format = PNG_FORMAT_RGB;
+  ImageGuard guard{png};
+  if (png_image_write_to_file(&png, path.c_str(), 0, packed.data(), 0, nullptr) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  return {};
+}
+
+std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  ImageGuard guard{png};
+  if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  png.format = PNG_FORMAT_RGB;
+  RgbImage out;
+  out.width = static_cast<int>(png.width);
+  out.height = static_cast<int>(png.height);
+  out.pixels.resize(static_cast<std::size_t>(png.width) * png.height);
+  if (png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  return out;
+}
+
+}  // namespace smx::host

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <expected>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "smx/algo/image_view.hpp"
+
+// PNG files for the host tool (libpng's simplified API). Errors are messages naming the file.
+namespace smx::host {
+
+struct RgbImage {
+  int width = 0;
+  int height = 0;
+  std::vector<algo::Rgb8> pixels;  // row-major, packed
+
+  [[nodiscard]] algo::ConstRgbView view() const {
+    return *algo::ConstRgbView::packed(pixels, width, height);
+  }
+};
+
+[[nodiscard]] std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
+                                                            algo::ConstRgbView image);
+
+// Any PNG (grey, palette, 16-bit, alpha) converted to 8-bit RGB.
+[[nodiscard]] std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path);
+
+}  // namespace smx::host
