@@ -147,7 +147,7 @@ BinAngle atan2Magnitudes(std::uint64_t ax, std::uint64_t ay, bool xNegative, boo
   const std::uint64_t b = kAtanTurn32[i + 1];
   const std::uint64_t turn32 = a + (((b - a) * f) >> 24);  // atan is increasing: b >= a
   // Round once, inside the octant, so that the reflections below are exact.
-  std::uint32_t angle = static_cast<std::uint32_t>(roundingShiftRight(turn32, 16, Round::kHalfUp));
+  auto angle = static_cast<std::uint32_t>(roundingShiftRight(turn32, 16, Round::kHalfUp));
   if (steep) {
     angle = BinAngle::kQuarterTurn - angle;
   }

@@ -82,16 +82,17 @@ inline constexpr int kTransitions = 6;
 
 namespace detail {
 
+// Colour index after a step: bit 1 is +1 (mod 3), bit 0 is −1 (i.e. +2).
+constexpr std::size_t step(std::size_t colour, std::size_t bit) {
+  return (colour + (bit != 0 ? 1 : 2)) % kColours;
+}
+
 // Hierholzer's algorithm over the 96 six-stripe nodes; node id = first colour · 32 + 5 step bits.
 // Out-edges are tried +1 first, so the sequence is deterministic and starts R, G, B, R, G, B.
 constexpr std::array<Colour, kStripes> buildSequence() {
   constexpr std::size_t kNodeBits = kWindowTransitions - 1;
   constexpr std::size_t kBitsMask = (std::size_t{1} << kNodeBits) - 1;
   constexpr std::size_t kNodes = std::size_t{kColours} << kNodeBits;
-  // Colour index after a step: bit 1 is +1 (mod 3), bit 0 is −1 (i.e. +2).
-  constexpr auto step = [](std::size_t colour, std::size_t bit) {
-    return (colour + (bit != 0 ? 1 : 2)) % kColours;
-  };
   std::array<std::size_t, kNodes> edgesTaken{};
   std::array<std::size_t, kWindows + 1> stack{};
   std::array<std::size_t, kWindows + 1> circuit{};
