@@ -54,11 +54,12 @@ int runPattern(const PatternOptions& opts, const CliStreams& io) {
   for (const auto& projector : rig->projectors) {
     std::vector<algo::Rgb8> pixels(static_cast<std::size_t>(projector.width) *
                                    static_cast<std::size_t>(projector.height));
-    auto view = algo::RgbView::packed(pixels, projector.width, projector.height);
-    if (auto rendered = view.and_then([&](algo::RgbView v) {
-          return algo::renderPatternImage(projector, v);
-        });
-        !rendered) {
+    const auto view = algo::RgbView::packed(pixels, projector.width, projector.height);
+    if (!view) {
+      io.err << "stripemux pattern: " << projector.id << ": " << view.error().message << "\n";
+      return kExitBadInput;
+    }
+    if (const auto rendered = algo::renderPatternImage(projector, *view); !rendered) {
       io.err << "stripemux pattern: " << projector.id << ": " << rendered.error().message << "\n";
       return kExitBadInput;
     }
