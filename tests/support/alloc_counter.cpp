@@ -20,8 +20,12 @@ void noteAllocation(std::size_t bytes) {
 
 namespace smx::test {
 
-std::uint64_t allocationsSoFar() { return gAllocations.load(std::memory_order_relaxed); }
-std::uint64_t bytesAllocatedSoFar() { return gBytes.load(std::memory_order_relaxed); }
+std::uint64_t allocationsSoFar() {
+  return gAllocations.load(std::memory_order_relaxed);
+}
+std::uint64_t bytesAllocatedSoFar() {
+  return gBytes.load(std::memory_order_relaxed);
+}
 
 }  // namespace smx::test
 
@@ -34,7 +38,9 @@ extern "C" int __sanitizer_install_malloc_and_free_hooks(  // NOLINT(bugprone-re
 
 namespace {
 
-void onMalloc(const volatile void* /*ptr*/, std::size_t bytes) { noteAllocation(bytes); }
+void onMalloc(const volatile void* /*ptr*/, std::size_t bytes) {
+  noteAllocation(bytes);
+}
 void onFree(const volatile void* /*ptr*/) {}
 
 // Installed before main; the hooks stay for the life of the process.
@@ -48,11 +54,11 @@ void onFree(const volatile void* /*ptr*/) {}
 // glibc's allocator under its internal names: the replacements below count, then forward, so
 // memory allocated anywhere (glibc itself included) is freed by the same allocator.
 extern "C" {
-void* __libc_malloc(std::size_t);               // NOLINT(bugprone-reserved-identifier)
-void* __libc_calloc(std::size_t, std::size_t);  // NOLINT(bugprone-reserved-identifier)
-void* __libc_realloc(void*, std::size_t);       // NOLINT(bugprone-reserved-identifier)
+void* __libc_malloc(std::size_t);                 // NOLINT(bugprone-reserved-identifier)
+void* __libc_calloc(std::size_t, std::size_t);    // NOLINT(bugprone-reserved-identifier)
+void* __libc_realloc(void*, std::size_t);         // NOLINT(bugprone-reserved-identifier)
 void* __libc_memalign(std::size_t, std::size_t);  // NOLINT(bugprone-reserved-identifier)
-void __libc_free(void*);                        // NOLINT(bugprone-reserved-identifier)
+void __libc_free(void*);                          // NOLINT(bugprone-reserved-identifier)
 
 void* malloc(std::size_t bytes) {
   noteAllocation(bytes);
@@ -86,7 +92,9 @@ int posix_memalign(void** out, std::size_t alignment, std::size_t bytes) {
   *out = p;
   return 0;
 }
-void free(void* ptr) { __libc_free(ptr); }
+void free(void* ptr) {
+  __libc_free(ptr);
+}
 }  // extern "C"
 
 namespace {
@@ -110,16 +118,26 @@ void* allocateOrNull(std::size_t bytes, std::size_t alignment) noexcept {
 }
 
 constexpr std::size_t kDefault = alignof(std::max_align_t);
-std::size_t toSize(std::align_val_t a) { return static_cast<std::size_t>(a); }
+std::size_t toSize(std::align_val_t a) {
+  return static_cast<std::size_t>(a);
+}
 
 }  // namespace
 
 // All replaceable global allocation functions ([new.delete]); the rest of the standard's
 // variants forward to these.
-void* operator new(std::size_t n) { return allocateOrThrow(n, kDefault); }
-void* operator new[](std::size_t n) { return allocateOrThrow(n, kDefault); }
-void* operator new(std::size_t n, std::align_val_t a) { return allocateOrThrow(n, toSize(a)); }
-void* operator new[](std::size_t n, std::align_val_t a) { return allocateOrThrow(n, toSize(a)); }
+void* operator new(std::size_t n) {
+  return allocateOrThrow(n, kDefault);
+}
+void* operator new[](std::size_t n) {
+  return allocateOrThrow(n, kDefault);
+}
+void* operator new(std::size_t n, std::align_val_t a) {
+  return allocateOrThrow(n, toSize(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+  return allocateOrThrow(n, toSize(a));
+}
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
   return allocateOrNull(n, kDefault);
 }
@@ -132,16 +150,36 @@ void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noe
 void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
   return allocateOrNull(n, toSize(a));
 }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { __libc_free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { __libc_free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { __libc_free(p); }
+void operator delete(void* p) noexcept {
+  __libc_free(p);
+}
+void operator delete[](void* p) noexcept {
+  __libc_free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  __libc_free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  __libc_free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  __libc_free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  __libc_free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  __libc_free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  __libc_free(p);
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept {
+  __libc_free(p);
+}
+void operator delete[](void* p, const std::nothrow_t&) noexcept {
+  __libc_free(p);
+}
 void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept {
   __libc_free(p);
 }

@@ -14,14 +14,17 @@
 namespace smx::test {
 
 struct SampledStripe {
-  int index;                   // stripe index the spec puts at this position
+  int index;                    // stripe index the spec puts at this position
   algo::stripe::Colour colour;  // colour found in the image there
 };
 
 inline std::optional<algo::stripe::Colour> primaryOf(algo::Rgb8 p) {
-  if (p == algo::Rgb8{255, 0, 0}) return algo::stripe::Colour::kRed;
-  if (p == algo::Rgb8{0, 255, 0}) return algo::stripe::Colour::kGreen;
-  if (p == algo::Rgb8{0, 0, 255}) return algo::stripe::Colour::kBlue;
+  if (p == algo::Rgb8{255, 0, 0})
+    return algo::stripe::Colour::kRed;
+  if (p == algo::Rgb8{0, 255, 0})
+    return algo::stripe::Colour::kGreen;
+  if (p == algo::Rgb8{0, 0, 255})
+    return algo::stripe::Colour::kBlue;
   return std::nullopt;
 }
 

@@ -12,7 +12,9 @@ namespace smx::test {
 namespace {
 
 // Keeps the optimiser from eliding an allocation whose result is never used (allowed for new).
-void escape(void* p) { asm volatile("" : : "g"(p) : "memory"); }
+void escape(void* p) {
+  asm volatile("" : : "g"(p) : "memory");
+}
 
 TEST(AllocCounter, CountsNothingWhenNothingAllocates) {
   AllocationCounter counter;

@@ -10,7 +10,9 @@
 namespace smx::algo {
 namespace {
 
-bool aligned(const void* p, std::size_t a) { return reinterpret_cast<std::uintptr_t>(p) % a == 0; }
+bool aligned(const void* p, std::size_t a) {
+  return reinterpret_cast<std::uintptr_t>(p) % a == 0;
+}
 
 TEST(Arena, CarvesAlignedDisjointBlocksFromTheCallersBuffer) {
   alignas(64) std::array<std::byte, 1024> buffer{};

@@ -32,8 +32,9 @@ CliRun run(std::vector<std::string> args) {
 class CliPattern : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("smx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir_ =
+        fs::temp_directory_path() /
+        ("smx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -96,8 +97,8 @@ TEST_F(CliPattern, BadRigIsRejectedWithFileAndFieldAndNothingWritten) {
 }
 
 TEST_F(CliPattern, MissingOrMalformedRigFileIsBadInput) {
-  const auto missing = run({"pattern", "--rig", (dir_ / "nope.json").string(), "--out",
-                            (dir_ / "o").string()});
+  const auto missing =
+      run({"pattern", "--rig", (dir_ / "nope.json").string(), "--out", (dir_ / "o").string()});
   EXPECT_EQ(missing.code, kExitBadInput);
   EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
 

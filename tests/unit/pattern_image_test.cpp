@@ -50,8 +50,7 @@ TEST(PatternImage, SequenceRecoveredAlongAxisAtAnyAngle) {
         for (std::size_t j = 0; j < 7; ++j) {
           w[j] = (*sampled)[k + j].colour;
         }
-        EXPECT_EQ(stripe::decodeWindow(std::span<const stripe::Colour, 7>(w)),
-                  (*sampled)[k].index);
+        EXPECT_EQ(stripe::decodeWindow(std::span<const stripe::Colour, 7>(w)), (*sampled)[k].index);
       }
     }
   }

@@ -122,8 +122,8 @@ TEST(StripeCode, RejectsEqualNeighboursAndBrokenChains) {
   const std::array<Transition, 6> broken = {T::kPlusRG, T::kPlusBR, T::kPlusRG,
                                             T::kPlusGB, T::kPlusBR, T::kPlusRG};
   EXPECT_EQ(decodeWindow(std::span<const Transition, 6>(broken)), -1);
-  const std::array<Colour, 7> outOfRange = {C::kRed, static_cast<C>(3), C::kRed, C::kGreen,
-                                            C::kBlue, C::kRed, C::kGreen};
+  const std::array<Colour, 7> outOfRange = {C::kRed,  static_cast<C>(3), C::kRed,  C::kGreen,
+                                            C::kBlue, C::kRed,           C::kGreen};
   EXPECT_EQ(decodeWindow(std::span<const Colour, 7>(outOfRange)), -1);
 }
 

@@ -35,7 +35,7 @@ std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
   png.width = static_cast<png_uint_32>(image.width());
   png.height = static_cast<png_uint_32>(image.height());
   png.format = PNG_FORMAT_RGB;
-  ImageGuard guard{png};
+  const ImageGuard guard{png};
   if (png_image_write_to_file(&png, path.c_str(), 0, packed.data(), 0, nullptr) == 0) {
     return std::unexpected(describe(path, png));
   }
@@ -45,7 +45,7 @@ std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
 std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path) {
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
-  ImageGuard guard{png};
+  const ImageGuard guard{png};
   if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
     return std::unexpected(describe(path, png));
   }

@@ -31,8 +31,8 @@ class Arena {
   [[nodiscard]] Result<std::span<std::byte>> allocateBytes(std::size_t bytes, std::size_t align);
 
   template <class T>
-    requires(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>)
-  [[nodiscard]] Result<std::span<T>> allocate(std::size_t count) {
+  requires(std::is_trivially_copyable_v<T>&& std::is_trivially_destructible_v<T>)
+      [[nodiscard]] Result<std::span<T>> allocate(std::size_t count) {
     if (count > kMaxBytes / sizeof(T)) {
       return fail(Errc::kOutOfMemory, "arena request overflows");
     }

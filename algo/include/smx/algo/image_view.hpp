@@ -19,6 +19,11 @@ struct Rgb8 {
 };
 static_assert(sizeof(Rgb8) == 3 && alignof(Rgb8) == 1);
 
+namespace detail {
+template <class From, class To>
+concept AddsConstTo = std::is_same_v<const From, To> && !std::is_same_v<From, To>;
+}  // namespace detail
+
 // Non-owning view of a 2-D image of Pixel with a row stride in bytes. Rows may be padded (V4L2
 // bytesperline need not be a multiple of the pixel size times the width). Pixel may be const for
 // read-only views; a mutable view converts to a const one.
@@ -58,8 +63,8 @@ class ImageView {
                      static_cast<std::ptrdiff_t>(sizeof(Pixel)) * width);
   }
 
-  template <class Other>
-    requires(std::is_same_v<const Other, Pixel> && !std::is_same_v<Other, Pixel>)
+  // Implicit on purpose: a mutable view is usable wherever a const one is expected.
+  template <detail::AddsConstTo<Pixel> Other>
   constexpr ImageView(const ImageView<Other>& other)  // NOLINT(google-explicit-constructor)
       : data_(other.bytes()),
         width_(other.width()),
@@ -90,9 +95,10 @@ class ImageView {
     const int y0 = clamp(y, 0, height_);
     const int x1 = clamp(x + w, x0, width_);
     const int y1 = clamp(y + h, y0, height_);
-    return ImageView(data_ + static_cast<std::ptrdiff_t>(y0) * strideBytes_ +
-                         static_cast<std::ptrdiff_t>(x0) * static_cast<std::ptrdiff_t>(sizeof(Pixel)),
-                     x1 - x0, y1 - y0, strideBytes_);
+    return ImageView(
+        data_ + static_cast<std::ptrdiff_t>(y0) * strideBytes_ +
+            static_cast<std::ptrdiff_t>(x0) * static_cast<std::ptrdiff_t>(sizeof(Pixel)),
+        x1 - x0, y1 - y0, strideBytes_);
   }
 
  private:

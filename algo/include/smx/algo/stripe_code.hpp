@@ -38,28 +38,34 @@ enum class Transition : std::uint8_t {
 };
 inline constexpr int kTransitions = 6;
 
-[[nodiscard]] constexpr Colour colourFromIndex(int i) { return static_cast<Colour>(i % kColours); }
-[[nodiscard]] constexpr int indexOf(Colour c) { return static_cast<int>(c); }
+[[nodiscard]] constexpr Colour colourFromIndex(int i) {
+  return static_cast<Colour>(i % kColours);
+}
+[[nodiscard]] constexpr int indexOf(Colour c) {
+  return static_cast<int>(c);
+}
 
-[[nodiscard]] constexpr bool isPlus(Transition t) { return static_cast<int>(t) % 2 == 0; }
+[[nodiscard]] constexpr bool isPlus(Transition t) {
+  return static_cast<int>(t) % 2 == 0;
+}
 
 [[nodiscard]] constexpr Colour from(Transition t) {
-  constexpr std::array<Colour, kTransitions> kFrom = {Colour::kRed,  Colour::kGreen,
-                                                      Colour::kGreen, Colour::kBlue,
-                                                      Colour::kBlue,  Colour::kRed};
+  constexpr std::array<Colour, kTransitions> kFrom = {Colour::kRed,  Colour::kGreen, Colour::kGreen,
+                                                      Colour::kBlue, Colour::kBlue,  Colour::kRed};
   return kFrom[static_cast<std::size_t>(t)];
 }
 
 [[nodiscard]] constexpr Colour to(Transition t) {
-  constexpr std::array<Colour, kTransitions> kTo = {Colour::kGreen, Colour::kRed,
-                                                    Colour::kBlue,  Colour::kGreen,
-                                                    Colour::kRed,   Colour::kBlue};
+  constexpr std::array<Colour, kTransitions> kTo = {Colour::kGreen, Colour::kRed, Colour::kBlue,
+                                                    Colour::kGreen, Colour::kRed, Colour::kBlue};
   return kTo[static_cast<std::size_t>(t)];
 }
 
 // The paper's grouping "by the colour after the boundary": R = {+BR, −RG}, G = {+RG, −GB},
 // B = {+GB, −BR}.
-[[nodiscard]] constexpr Colour colourAfter(Transition t) { return to(t); }
+[[nodiscard]] constexpr Colour colourAfter(Transition t) {
+  return to(t);
+}
 
 // The transition a→b; a and b must differ.
 [[nodiscard]] constexpr Transition transitionBetween(Colour a, Colour b) {
