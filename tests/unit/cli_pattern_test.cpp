@@ -8,7 +8,7 @@
 
 #include "cli.hpp"
 #include "pattern_sampler.hpp"
-#include "png_io.hpp"
+#include "smx/sim/png_io.hpp"
 #include "smx/protocol/rig_json.hpp"
 
 namespace smx::host {
@@ -63,7 +63,7 @@ TEST_F(CliPattern, WritesEachProjectorsPatternRecoverableAlongItsAxis) {
     const auto rig = protocol::loadRig(rigPath);
     ASSERT_TRUE(rig.has_value());
     for (const auto& projector : rig->projectors) {
-      const auto image = readPngRgb8(out / (projector.id + ".png"));
+      const auto image = sim::readPngRgb8(out / (projector.id + ".png"));
       ASSERT_TRUE(image.has_value()) << image.error();
       EXPECT_EQ(image->width, projector.width);
       EXPECT_EQ(image->height, projector.height);

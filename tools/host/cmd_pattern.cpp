@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "png_io.hpp"
+#include "smx/sim/png_io.hpp"
 #include "smx/algo/pattern_image.hpp"
 #include "smx/protocol/rig_json.hpp"
 
@@ -64,7 +64,7 @@ int runPattern(const PatternOptions& opts, const CliStreams& io) {
       return kExitBadInput;
     }
     const auto file = opts.out / (projector.id + ".png");
-    if (auto written = writePngRgb8(file, *view); !written) {
+    if (auto written = sim::writePngRgb8(file, *view); !written) {
       io.err << "stripemux pattern: " << written.error() << "\n";
       return kExitDeviceOrIo;
     }

@@ -7,8 +7,8 @@
 
 #include "smx/algo/image_view.hpp"
 
-// PNG files for the host tool (libpng's simplified API). Errors are messages naming the file.
-namespace smx::host {
+// PNG files for the host tool and the simulated camera (libpng's simplified API). Errors are messages naming the file.
+namespace smx::sim {
 
 struct RgbImage {
   int width = 0;
@@ -26,4 +26,4 @@ struct RgbImage {
 // Any PNG (grey, palette, 16-bit, alpha) converted to 8-bit RGB.
 [[nodiscard]] std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path);
 
-}  // namespace smx::host
+}  // namespace smx::sim

@@ -1,11 +1,11 @@
-#include "png_io.hpp"
+#include "smx/sim/png_io.hpp"
 
 #include <png.h>
 
 #include <cstring>
 #include <memory>
 
-namespace smx::host {
+namespace smx::sim {
 namespace {
 
 // png_image owns libpng state until finished or freed; free it on every exit path.
@@ -60,4 +60,4 @@ std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& pa
   return out;
 }
 
-}  // namespace smx::host
+}  // namespace smx::sim

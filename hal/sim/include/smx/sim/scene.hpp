@@ -1,0 +1,116 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+// What the simulated rig looks at: objects with shape, pose, motion and albedo, plus the light and
+// camera-response settings of the render (scene.json, docs/scene-format.md). World frame and
+// units as in rig.json: metres, x right, y down, z forward (the example rigs use cam0's frame).
+namespace smx::sim {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// Object → world: X = R · (scale · x) + t.
+struct Pose {
+  Mat3 R = Mat3::Identity();
+  Vec3 t = Vec3::Zero();
+  double scale = 1.0;
+};
+
+// Rigid motion standing in for a moving object: at frame f the object is first rotated by
+// f · angularDegPerFrame about `axis` (world direction) through `pivot` (world point), then
+// translated by f · velocityMPerFrame. Frame 0 is the pose as given.
+struct Motion {
+  Vec3 velocityMPerFrame = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();
+  double angularDegPerFrame = 0.0;
+  Vec3 pivot = Vec3::Zero();
+};
+
+// Albedo textures are evaluated at the object-local surface point (x, y) (a planar mapping along
+// local z; for a plane that is its own surface).
+struct CheckerTexture {
+  double squareM = 0.04;
+  // Cycled along x, shifted by one per row: the paper's Fig. 13 RGBCMY panel by default.
+  std::vector<Vec3> colours = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 1, 1}, {1, 0, 1}, {1, 1, 0}};
+};
+
+struct ImageTexture {
+  std::string path;     // PNG, resolved relative to the scene file
+  double widthM = 0.2;  // the image spans [-w/2, w/2] × [-h/2, h/2] in local x, y; repeats
+  double heightM = 0.2;
+  int width = 0;  // filled by the loader
+  int height = 0;
+  std::vector<std::array<float, 3>> texels;  // linear albedo in [0, 1], row-major
+};
+
+struct Albedo {
+  Vec3 rgb{0.8, 0.8, 0.8};  // constant albedo in [0, 1] per channel (used when no texture)
+  std::variant<std::monostate, CheckerTexture, ImageTexture> texture;
+};
+
+// Shapes, in object-local coordinates, centred on the local origin.
+struct Plane {  // finite rectangle in the local x-y plane, normal ±z (two-sided)
+  double widthM = 1.0;
+  double heightM = 1.0;
+};
+struct Box {
+  Vec3 sizeM{0.1, 0.1, 0.1};
+};
+struct Sphere {
+  double radiusM = 0.1;
+};
+struct Cylinder {  // axis along local y (down in a level rig), from -h/2 to +h/2
+  double radiusM = 0.05;
+  double heightM = 0.1;
+  bool capped = true;
+};
+struct Mesh {
+  std::string path;                       // PLY or OBJ, resolved relative to the scene file
+  std::vector<Eigen::Vector3f> vertices;  // filled by the loader
+  std::vector<std::array<std::uint32_t, 3>> triangles;  // filled by the loader
+};
+
+using Shape = std::variant<Plane, Box, Sphere, Cylinder, Mesh>;
+
+struct Object {
+  std::string name;
+  Shape shape;
+  Pose pose;
+  Motion motion;
+  Albedo albedo;
+};
+
+struct Lighting {
+  // Light that does not come from the projectors, as a fraction of full scale per channel.
+  Vec3 ambient{0.03, 0.03, 0.03};
+  // Projector brightness: irradiance of a full-level pixel on a surface facing it at
+  // referenceDistanceM, as a fraction of full scale.
+  double projectorPower = 0.9;
+  bool inverseSquare = false;  // 1/d² falloff relative to referenceDistanceM
+  double referenceDistanceM = 0.9;
+  double projectorDefocusSigmaPx = 0.0;  // Gaussian blur of the projector image, projector px
+};
+
+struct CameraResponse {
+  Mat3 crosstalk = Mat3::Identity();        // camera RGB = crosstalk · scene RGB
+  double gain = 1.0;                        // exposure gain
+  Vec3 noiseSigma{1.8138, 1.2923, 1.6745};  // Gaussian noise per channel, grey levels
+  double defocusSigmaPx = 0.0;              // Gaussian blur of the camera image, camera px
+};
+
+struct Scene {
+  std::vector<Object> objects;
+  Lighting lighting;
+  CameraResponse camera;
+  int supersampling = 2;  // n × n samples per camera pixel
+};
+
+}  // namespace smx::sim
