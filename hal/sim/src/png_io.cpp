@@ -3,7 +3,6 @@
 #include <png.h>
 
 #include <cstring>
-#include <memory>
 
 namespace smx::sim {
 namespace {
@@ -18,13 +17,13 @@ std::string describe(const std::filesystem::path& path, const png_image& image) 
   return path.string() + ": " + image.message;
 }
 
-}  // namespace
-
-std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
-                                              algo::ConstRgbView image) {
-  // libpng wants rows whose stride is a whole number of pixels: pack padded views first.
-  std::vector<algo::Rgb8> packed(static_cast<std::size_t>(image.width()) *
-                                 static_cast<std::size_t>(image.height()));
+// libpng wants rows whose stride is a whole number of pixels: pack (possibly padded) views first.
+template <class Pixel>
+std::expected<void, std::string> writePacked(const std::filesystem::path& path,
+                                             algo::ImageView<const Pixel> image,
+                                             png_uint_32 format) {
+  std::vector<Pixel> packed(static_cast<std::size_t>(image.width()) *
+                            static_cast<std::size_t>(image.height()));
   for (int y = 0; y < image.height(); ++y) {
     const auto row = image.row(y);
     std::memcpy(packed.data() + static_cast<std::size_t>(y) * row.size(), row.data(),
@@ -34,12 +33,24 @@ std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
   png.version = PNG_IMAGE_VERSION;
   png.width = static_cast<png_uint_32>(image.width());
   png.height = static_cast<png_uint_32>(image.height());
-  png.format = PNG_FORMAT_RGB;
+  png.format = format;
   const ImageGuard guard{png};
   if (png_image_write_to_file(&png, path.c_str(), 0, packed.data(), 0, nullptr) == 0) {
     return std::unexpected(describe(path, png));
   }
   return {};
+}
+
+}  // namespace
+
+std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
+                                              algo::ConstRgbView image) {
+  return writePacked(path, image, PNG_FORMAT_RGB);
+}
+
+std::expected<void, std::string> writePngGray8(const std::filesystem::path& path,
+                                               algo::ImageView<const std::uint8_t> image) {
+  return writePacked(path, image, PNG_FORMAT_GRAY);
 }
 
 std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <expected>
 #include <filesystem>
 #include <string>
@@ -7,7 +8,8 @@
 
 #include "smx/algo/image_view.hpp"
 
-// PNG files for the host tool and the simulated camera (libpng's simplified API). Errors are messages naming the file.
+// PNG files for the host tool and the simulated camera (libpng's simplified API). Errors are
+// messages naming the file.
 namespace smx::sim {
 
 struct RgbImage {
@@ -22,6 +24,10 @@ struct RgbImage {
 
 [[nodiscard]] std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
                                                             algo::ConstRgbView image);
+
+// 8-bit grey (masks).
+[[nodiscard]] std::expected<void, std::string> writePngGray8(
+    const std::filesystem::path& path, algo::ImageView<const std::uint8_t> image);
 
 // Any PNG (grey, palette, 16-bit, alpha) converted to 8-bit RGB.
 [[nodiscard]] std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path);
