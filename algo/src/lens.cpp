@@ -4,21 +4,22 @@
 
 namespace smx::algo::lens {
 
-Point2 distort(const std::array<double, 5>& dist, Point2 p) {
+Point2 distort(const std::array<double, 5>& dist, Point2 undistorted) {
   const auto [k1, k2, p1, p2, k3] = dist;
-  const double r2 = p.x * p.x + p.y * p.y;
+  const auto [x, y] = undistorted;
+  const double r2 = x * x + y * y;
   const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  return {p.x * radial + 2.0 * p1 * p.x * p.y + p2 * (r2 + 2.0 * p.x * p.x),
-          p.y * radial + p1 * (r2 + 2.0 * p.y * p.y) + 2.0 * p2 * p.x * p.y};
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
 }
 
-std::optional<Point2> undistort(const std::array<double, 5>& dist, Point2 target) {
+std::optional<Point2> undistort(const std::array<double, 5>& dist, Point2 distorted) {
   const auto [k1, k2, p1, p2, k3] = dist;
-  Point2 p = target;
+  Point2 p = distorted;
   for (int iteration = 0; iteration < 50; ++iteration) {
     const Point2 d = distort(dist, p);
-    const double ex = d.x - target.x;
-    const double ey = d.y - target.y;
+    const double ex = d.x - distorted.x;
+    const double ey = d.y - distorted.y;
     if (std::abs(ex) < 1e-12 && std::abs(ey) < 1e-12) {
       return p;
     }
@@ -41,17 +42,18 @@ std::optional<Point2> undistort(const std::array<double, 5>& dist, Point2 target
 }
 
 Point3 toDevice(const DeviceModel& d, const Point3& w) {
-  const auto& R = d.R;
-  return {R[0] * w[0] + R[1] * w[1] + R[2] * w[2] + d.t[0],
-          R[3] * w[0] + R[4] * w[1] + R[5] * w[2] + d.t[1],
-          R[6] * w[0] + R[7] * w[1] + R[8] * w[2] + d.t[2]};
+  const auto& rot = d.R;
+  return {rot[0] * w[0] + rot[1] * w[1] + rot[2] * w[2] + d.t[0],
+          rot[3] * w[0] + rot[4] * w[1] + rot[5] * w[2] + d.t[1],
+          rot[6] * w[0] + rot[7] * w[1] + rot[8] * w[2] + d.t[2]};
 }
 
 Point3 centre(const DeviceModel& d) {
-  const auto& R = d.R;
+  const auto& rot = d.R;
   const auto& t = d.t;
-  return {-(R[0] * t[0] + R[3] * t[1] + R[6] * t[2]), -(R[1] * t[0] + R[4] * t[1] + R[7] * t[2]),
-          -(R[2] * t[0] + R[5] * t[1] + R[8] * t[2])};
+  return {-(rot[0] * t[0] + rot[3] * t[1] + rot[6] * t[2]),
+          -(rot[1] * t[0] + rot[4] * t[1] + rot[7] * t[2]),
+          -(rot[2] * t[0] + rot[5] * t[1] + rot[8] * t[2])};
 }
 
 std::optional<Point2> project(const DeviceModel& d, const Point3& world) {
@@ -68,10 +70,10 @@ std::optional<Ray> pixelRay(const DeviceModel& d, Point2 pixel) {
   if (!xn) {
     return std::nullopt;
   }
-  const auto& R = d.R;
+  const auto& rot = d.R;
   // Direction Rᵀ·(x, y, 1), normalised.
-  Point3 dir = {R[0] * xn->x + R[3] * xn->y + R[6], R[1] * xn->x + R[4] * xn->y + R[7],
-                R[2] * xn->x + R[5] * xn->y + R[8]};
+  Point3 dir = {rot[0] * xn->x + rot[3] * xn->y + rot[6], rot[1] * xn->x + rot[4] * xn->y + rot[7],
+                rot[2] * xn->x + rot[5] * xn->y + rot[8]};
   const double n = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
   for (auto& c : dir) {
     c /= n;

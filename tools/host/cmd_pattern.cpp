@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "smx/sim/png_io.hpp"
 #include "smx/algo/pattern_image.hpp"
 #include "smx/protocol/rig_json.hpp"
+#include "smx/sim/png_io.hpp"
 
 namespace smx::host {
 namespace {
