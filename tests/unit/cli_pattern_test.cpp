@@ -1,53 +1,27 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "cli_harness.hpp"
 #include "pattern_sampler.hpp"
-#include "smx/sim/png_io.hpp"
 #include "smx/protocol/rig_json.hpp"
+#include "smx/sim/png_io.hpp"
 
 namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code;
-  std::string out;
-  std::string err;
-};
+using test::CliRun;
 
-CliRun run(std::vector<std::string> args) {
-  std::ostringstream out;
-  std::ostringstream err;
-  const int code = runCli(args, {out, err});
-  return {code, out.str(), err.str()};
+CliRun run(const std::vector<std::string>& args) {
+  return test::runCli(args);
 }
 
-class CliPattern : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ =
-        fs::temp_directory_path() /
-        ("smx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path writeFile(const std::string& name, const std::string& text) {
-    const auto path = dir_ / name;
-    std::ofstream(path) << text;
-    return path;
-  }
-
-  fs::path dir_;
-};
+class CliPattern : public test::CliTest {};
 
 const std::string kExampleRigs[] = {"rig_2proj_1cam.json", "rig_2proj_2cam.json",
                                     "rig_3proj_1cam.json", "rig_3proj_2cam.json"};

@@ -13,6 +13,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
 
   int exitCode = kExitOk;
   addPatternCommand(app, io, exitCode);
+  addSimCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -1,1 +1,928 @@
-namespace smx::sim {}
+#include "smx/sim/renderer.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <string>
+#include <thread>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "gaussian_blur.hpp"
+#include "shape_geometry.hpp"
+#include "smx/algo/lens.hpp"
+#include "smx/algo/pattern_image.hpp"
+
+// The model, its order of operations and the ground-truth definitions are in docs/simulator.md.
+namespace smx::sim {
+namespace {
+
+namespace lens = algo::lens;
+using detail::RgbF;
+
+constexpr unsigned kInvalidId = RTC_INVALID_GEOMETRY_ID;
+// Debian's Embree is built with ray masks: a ray with mask 0 hits nothing.
+constexpr unsigned kAllGeometry = 0xFFFFFFFFU;
+// Shadow rays start this far off the surface along its normal: 100× Embree's float rounding of
+// the origin at a few metres, far below any scene detail.
+constexpr double kShadowOffsetM = 1e-5;
+constexpr int kMaxSupersampling = 16;
+// Camera sample rays are cached per camera when the table stays below this (640×480 at 3×3
+// supersampling fits); otherwise every frame undistorts them again.
+constexpr std::size_t kMaxRayTableBytes = std::size_t{64} << 20U;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+struct DeviceDeleter {
+  void operator()(RTCDevice d) const { rtcReleaseDevice(d); }
+};
+struct SceneDeleter {
+  void operator()(RTCScene s) const { rtcReleaseScene(s); }
+};
+struct GeometryDeleter {
+  void operator()(RTCGeometry g) const { rtcReleaseGeometry(g); }
+};
+using DeviceHandle = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
+using SceneHandle = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+using GeometryHandle = std::unique_ptr<RTCGeometryTy, GeometryDeleter>;
+
+Vec3 toVec(const lens::Point3& p) {
+  return {p[0], p[1], p[2]};
+}
+
+// x ∈ [lo, hi); false for NaN.
+bool inHalfOpen(double x, double lo, double hi) {
+  return x >= lo && x < hi;
+}
+
+std::size_t pixelIndex(int x, int y, int width) {
+  return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+         static_cast<std::size_t>(x);
+}
+
+// Object → world at one frame: X = R·(scale·x) + t.
+struct FramePose {
+  FramePose() = default;
+  FramePose(const Mat3& rotation, Vec3 translation, double s)
+      : R(rotation), t(std::move(translation)), scale(s), inverse(rotation.transpose() / s) {}
+
+  Mat3 R = Mat3::Identity();
+  Vec3 t = Vec3::Zero();
+  double scale = 1.0;
+  Mat3 inverse = Mat3::Identity();  // Rᵀ / scale: the ray callbacks run this per ray
+
+  [[nodiscard]] Vec3 toWorld(const Vec3& x) const { return R * (scale * x) + t; }
+  [[nodiscard]] Vec3 toLocal(const Vec3& world) const { return inverse * (world - t); }
+  // Keeps the ray parameter: local o + t·d is the local image of world o + t·d.
+  [[nodiscard]] Vec3 directionToLocal(const Vec3& d) const { return inverse * d; }
+};
+
+bool moves(const Motion& m) {
+  return !m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0;
+}
+
+// scene.hpp: rotate by f·angle about `axis` through `pivot`, then translate by f·velocity.
+FramePose poseAt(const Object& object, int frame) {
+  if (frame == 0 || !moves(object.motion)) {
+    return {object.pose.R, object.pose.t, object.pose.scale};
+  }
+  const double f = frame;
+  const auto& m = object.motion;
+  const Mat3 turn =
+      Eigen::AngleAxisd(f * m.angularDegPerFrame * std::numbers::pi / 180.0, m.axis.normalized())
+          .toRotationMatrix();
+  return {turn * object.pose.R,
+          turn * (object.pose.t - m.pivot) + m.pivot + f * m.velocityMPerFrame, object.pose.scale};
+}
+
+// Per object: its Embree geometry and, for analytic shapes, the surfaces the user-geometry
+// callbacks intersect (geometryUserPtr points here, so the vector holding these never resizes
+// after the geometries are created).
+struct ObjectState {
+  const Object* object = nullptr;
+  FramePose pose;  // at the committed frame
+  std::vector<detail::Surface> surfaces;
+  GeometryHandle geometry;  // in the world scene: a user geometry, or an instance of meshScene
+  SceneHandle meshScene;    // meshes: the triangles in local coordinates
+};
+
+// ---- Embree user-geometry callbacks for the analytic shapes (double inside) ----
+
+float lowerBound(double x, double pad) {
+  return std::nextafter(static_cast<float>(x - pad), -INFINITY);
+}
+float upperBound(double x, double pad) {
+  return std::nextafter(static_cast<float>(x + pad), INFINITY);
+}
+
+void surfaceBoundsCallback(const RTCBoundsFunctionArguments* args) {
+  const auto& state = *static_cast<const ObjectState*>(args->geometryUserPtr);
+  const detail::LocalBox local = detail::surfaceBounds(state.surfaces[args->primID]);
+  const Vec3 centre = state.pose.toWorld(local.centre);
+  const Vec3 half = state.pose.R.cwiseAbs() * (state.pose.scale * local.halfSize);
+  const double pad = 1e-6 * (1.0 + centre.cwiseAbs().maxCoeff() + half.maxCoeff());
+  RTCBounds& b = *args->bounds_o;
+  b.lower_x = lowerBound(centre.x() - half.x(), pad);
+  b.lower_y = lowerBound(centre.y() - half.y(), pad);
+  b.lower_z = lowerBound(centre.z() - half.z(), pad);
+  b.upper_x = upperBound(centre.x() + half.x(), pad);
+  b.upper_y = upperBound(centre.y() + half.y(), pad);
+  b.upper_z = upperBound(centre.z() + half.z(), pad);
+}
+
+struct LocalRay {
+  Vec3 origin;
+  Vec3 direction;
+  double tNear;
+  double tFar;
+};
+
+LocalRay localRay(const FramePose& pose, RTCRayN* rays, unsigned n, unsigned i) {
+  const Vec3 o(RTCRayN_org_x(rays, n, i), RTCRayN_org_y(rays, n, i), RTCRayN_org_z(rays, n, i));
+  const Vec3 d(RTCRayN_dir_x(rays, n, i), RTCRayN_dir_y(rays, n, i), RTCRayN_dir_z(rays, n, i));
+  return {pose.toLocal(o), pose.directionToLocal(d), RTCRayN_tnear(rays, n, i),
+          RTCRayN_tfar(rays, n, i)};
+}
+
+void surfaceIntersectCallback(const RTCIntersectFunctionNArguments* args) {
+  const auto& state = *static_cast<const ObjectState*>(args->geometryUserPtr);
+  const detail::Surface& surface = state.surfaces[args->primID];
+  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) {
+      continue;
+    }
+    const LocalRay r = localRay(state.pose, rays, args->N, i);
+    const auto hit = detail::intersectSurface(surface, r.origin, r.direction, r.tNear, r.tFar);
+    if (!hit) {
+      continue;
+    }
+    const Vec3 n = state.pose.R * hit->normal;
+    RTCRayN_tfar(rays, args->N, i) = static_cast<float>(hit->t);
+    RTCHitN_Ng_x(hits, args->N, i) = static_cast<float>(n.x());
+    RTCHitN_Ng_y(hits, args->N, i) = static_cast<float>(n.y());
+    RTCHitN_Ng_z(hits, args->N, i) = static_cast<float>(n.z());
+    RTCHitN_u(hits, args->N, i) = 0.0F;
+    RTCHitN_v(hits, args->N, i) = 0.0F;
+    RTCHitN_primID(hits, args->N, i) = args->primID;
+    RTCHitN_geomID(hits, args->N, i) = args->geomID;
+    RTCHitN_instID(hits, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void surfaceOccludedCallback(const RTCOccludedFunctionNArguments* args) {
+  const auto& state = *static_cast<const ObjectState*>(args->geometryUserPtr);
+  const detail::Surface& surface = state.surfaces[args->primID];
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) {
+      continue;
+    }
+    const LocalRay r = localRay(state.pose, args->ray, args->N, i);
+    if (detail::intersectSurface(surface, r.origin, r.direction, r.tNear, r.tFar)) {
+      RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's "occluded"
+    }
+  }
+}
+
+void setInstanceTransform(RTCGeometry instance, const FramePose& pose) {
+  std::array<float, 12> m{};  // 3×4 column-major [R·scale | t]
+  for (std::size_t col = 0; col < 3; ++col) {
+    const auto c = static_cast<Eigen::Index>(col);
+    for (std::size_t row = 0; row < 3; ++row) {
+      m[col * 3 + row] = static_cast<float>(pose.scale * pose.R(static_cast<Eigen::Index>(row), c));
+    }
+    m[9 + col] = static_cast<float>(pose.t[c]);
+  }
+  rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m.data());
+}
+
+// ---- Scene validation (create) ----
+
+bool finite(const Vec3& v) {
+  return v.allFinite();
+}
+bool positive(double x) {
+  return x > 0.0 && std::isfinite(x);
+}
+
+std::string shapeProblem(const Shape& shape) {
+  if (const auto* p = std::get_if<Plane>(&shape)) {
+    return positive(p->widthM) && positive(p->heightM) ? "" : "plane size must be positive";
+  }
+  if (const auto* b = std::get_if<Box>(&shape)) {
+    return positive(b->sizeM.x()) && positive(b->sizeM.y()) && positive(b->sizeM.z())
+               ? ""
+               : "box size must be positive";
+  }
+  if (const auto* s = std::get_if<Sphere>(&shape)) {
+    return positive(s->radiusM) ? "" : "sphere radius must be positive";
+  }
+  if (const auto* c = std::get_if<Cylinder>(&shape)) {
+    return positive(c->radiusM) && positive(c->heightM)
+               ? ""
+               : "cylinder radius and height must be positive";
+  }
+  const auto& mesh = std::get<Mesh>(shape);
+  if (mesh.triangles.empty() || mesh.vertices.empty()) {
+    return "mesh \"" + mesh.path + "\" is empty (no triangles)";
+  }
+  if (mesh.vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
+    return "mesh has too many vertices";
+  }
+  for (const auto& v : mesh.vertices) {
+    if (!v.allFinite()) {
+      return "mesh has a vertex that is not finite";
+    }
+  }
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    for (const std::uint32_t k : mesh.triangles[i]) {
+      if (k >= mesh.vertices.size()) {
+        return "mesh triangle " + std::to_string(i) + " names vertex " + std::to_string(k) +
+               " of " + std::to_string(mesh.vertices.size());
+      }
+    }
+  }
+  return "";
+}
+
+std::string albedoProblem(const Albedo& albedo) {
+  if (!finite(albedo.rgb)) {
+    return "albedo must be finite";
+  }
+  if (const auto* c = std::get_if<CheckerTexture>(&albedo.texture)) {
+    if (!positive(c->squareM) || c->colours.empty()) {
+      return "checker texture needs a positive square size and at least one colour";
+    }
+  }
+  if (const auto* t = std::get_if<ImageTexture>(&albedo.texture)) {
+    if (t->width <= 0 || t->height <= 0 ||
+        t->texels.size() !=
+            static_cast<std::size_t>(t->width) * static_cast<std::size_t>(t->height) ||
+        !positive(t->widthM) || !positive(t->heightM)) {
+      return "image texture \"" + t->path + "\" is not loaded or has no size";
+    }
+  }
+  return "";
+}
+
+std::string objectProblem(const Object& o) {
+  if (std::string p = shapeProblem(o.shape); !p.empty()) {
+    return p;
+  }
+  const Mat3& rot = o.pose.R;
+  if (!rot.allFinite() || (rot * rot.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+      rot.determinant() < 0.0) {
+    return "pose R is not a rotation";
+  }
+  if (!finite(o.pose.t) || !positive(o.pose.scale)) {
+    return "pose t must be finite and scale positive";
+  }
+  if (!finite(o.motion.velocityMPerFrame) || !finite(o.motion.pivot) ||
+      !std::isfinite(o.motion.angularDegPerFrame) ||
+      (o.motion.angularDegPerFrame != 0.0 && !(o.motion.axis.norm() > 0.0))) {
+    return "motion must be finite, with a non-zero axis when it turns";
+  }
+  return albedoProblem(o.albedo);
+}
+
+std::string sceneProblem(const Scene& scene) {
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    if (const std::string p = objectProblem(scene.objects[i]); !p.empty()) {
+      return "objects[" + std::to_string(i) + "] (\"" + scene.objects[i].name + "\"): " + p;
+    }
+  }
+  if (scene.supersampling < 1 || scene.supersampling > kMaxSupersampling) {
+    return "supersampling must be 1 … " + std::to_string(kMaxSupersampling) + ", got " +
+           std::to_string(scene.supersampling);
+  }
+  const auto& l = scene.lighting;
+  if (!finite(l.ambient) || !std::isfinite(l.projectorPower) ||
+      !(l.projectorDefocusSigmaPx >= 0.0) || !std::isfinite(l.projectorDefocusSigmaPx) ||
+      (l.inverseSquare && !positive(l.referenceDistanceM))) {
+    return "lighting: values must be finite, defocus ≥ 0, reference distance positive";
+  }
+  const auto& c = scene.camera;
+  if (!c.crosstalk.allFinite() || !std::isfinite(c.gain) || !finite(c.noiseSigma) ||
+      (c.noiseSigma.array() < 0.0).any() || !(c.defocusSigmaPx >= 0.0) ||
+      !std::isfinite(c.defocusSigmaPx)) {
+    return "camera response: values must be finite, noise and defocus ≥ 0";
+  }
+  return "";
+}
+
+Vec3 albedoAt(const Albedo& albedo, const Vec3& local) {
+  if (const auto* c = std::get_if<CheckerTexture>(&albedo.texture)) {
+    const auto n = static_cast<double>(c->colours.size());
+    double k =
+        std::fmod(std::floor(local.x() / c->squareM) + std::floor(local.y() / c->squareM), n);
+    if (k < 0.0) {
+      k += n;
+    }
+    return c->colours[std::min(static_cast<std::size_t>(k), c->colours.size() - 1)];
+  }
+  if (const auto* t = std::get_if<ImageTexture>(&albedo.texture)) {
+    // Nearest texel; row 0 at local y = −h/2 (y points down, like image rows); repeats.
+    double fu = local.x() / t->widthM + 0.5;
+    double fv = local.y() / t->heightM + 0.5;
+    fu -= std::floor(fu);
+    fv -= std::floor(fv);
+    const int col = std::min(static_cast<int>(fu * t->width), t->width - 1);
+    const int row = std::min(static_cast<int>(fv * t->height), t->height - 1);
+    const auto& texel = t->texels[pixelIndex(col, row, t->width)];
+    return {texel[0], texel[1], texel[2]};
+  }
+  return albedo.rgb;
+}
+
+// Runs fn(y) for every row, rows shared dynamically between the hardware threads. Each row must
+// write only its own outputs; then the result does not depend on the split.
+template <class Fn>
+void forEachRow(int height, const Fn& fn) {
+  std::atomic<int> nextRow{0};
+  const auto work = [&] {
+    for (int y = nextRow++; y < height; y = nextRow++) {
+      fn(y);
+    }
+  };
+  const unsigned threads = std::clamp(std::thread::hardware_concurrency(), 1U, 16U);
+  std::vector<std::jthread> helpers;
+  for (unsigned i = 1; i < threads && static_cast<int>(i) < height; ++i) {
+    helpers.emplace_back(work);
+  }
+  work();
+}
+
+struct SurfacePoint {
+  Vec3 point;
+  Vec3 normal;  // unit, world, facing the ray's origin
+  std::size_t object = 0;
+};
+
+// A surface point as one projector lights it.
+struct Illumination {
+  double u = 0.0;  // continuous projector pixel coordinates
+  double v = 0.0;
+  std::size_t pixel = 0;  // the projector pixel containing (u, v), row-major
+  double cosTheta = 0.0;
+  double distanceM = 0.0;
+};
+
+struct ProjectorState {
+  Vec3 centre;
+  std::vector<RgbF> light;  // pattern image / 255 after the defocus blur, row-major
+};
+
+class EmbreeRenderer final : public Renderer {
+ public:
+  EmbreeRenderer(algo::Rig rig, Scene scene) : rig_(std::move(rig)), scene_(std::move(scene)) {}
+
+  std::expected<void, std::string> init();
+
+  std::expected<void, std::string> render(const FrameRequest& request, algo::RgbView image,
+                                          GroundTruthViews* truth) override;
+
+ private:
+  struct FrameContext {
+    const algo::Camera* camera = nullptr;
+    const std::vector<bool>* lit = nullptr;
+    GroundTruthViews* truth = nullptr;
+    std::vector<double> sampleOffsets;              // stratum centres within a pixel, per axis
+    const std::vector<RgbF>* sampleRays = nullptr;  // cached directions, or null: undistort
+  };
+
+  std::expected<void, std::string> initProjectors();
+  std::expected<void, std::string> initGeometry();
+  std::expected<void, std::string> check(const FrameRequest& request, algo::RgbView image,
+                                         const GroundTruthViews* truth) const;
+  void setFrame(int frame);
+  const std::vector<RgbF>* sampleRays(const FrameContext& ctx, int cameraIndex);
+  void shadeRow(const FrameContext& ctx, int y);
+  void writeTruth(const FrameContext& ctx, int x, int y) const;
+  void addNoiseAndQuantise(const FrameRequest& request, algo::RgbView image) const;
+
+  [[nodiscard]] std::optional<SurfacePoint> trace(const Vec3& origin, const Vec3& dir) const;
+  [[nodiscard]] bool occluded(const Vec3& from, const Vec3& to) const;
+  [[nodiscard]] std::optional<Illumination> illuminate(std::size_t p, const SurfacePoint& s) const;
+  [[nodiscard]] Vec3 radiance(const SurfacePoint& s, const std::vector<bool>& lit) const;
+
+  algo::Rig rig_;
+  Scene scene_;
+  std::vector<ProjectorState> projectors_;
+  std::string embreeError_;  // outlives device_: the error callback writes here
+  DeviceHandle device_;
+  std::vector<ObjectState> objects_;  // index = geometry ID in world_
+  SceneHandle world_;
+  bool anyMotion_ = false;
+  int frame_ = 0;  // the frame world_ is committed for
+  std::vector<RgbF> linear_;
+  std::vector<std::vector<RgbF>> sampleRays_;  // per camera: direction of every sample, float
+};
+
+std::expected<void, std::string> EmbreeRenderer::init() {
+  if (const std::string p = sceneProblem(scene_); !p.empty()) {
+    return std::unexpected(p);
+  }
+  if (auto ok = initProjectors(); !ok) {
+    return ok;
+  }
+  return initGeometry();
+}
+
+std::expected<void, std::string> EmbreeRenderer::initProjectors() {
+  projectors_.resize(rig_.projectors.size());
+  for (std::size_t p = 0; p < rig_.projectors.size(); ++p) {
+    const auto& model = rig_.projectors[p];
+    const std::string name = "projectors[" + std::to_string(p) + "]: ";
+    if (model.width <= 0 || model.height <= 0) {
+      return std::unexpected(name + "image size must be positive");
+    }
+    const std::size_t count =
+        static_cast<std::size_t>(model.width) * static_cast<std::size_t>(model.height);
+    std::vector<algo::Rgb8> pattern(count);
+    auto view = algo::RgbView::packed(pattern, model.width, model.height);
+    if (!view) {
+      return std::unexpected(name + view.error().message);
+    }
+    if (auto ok = algo::renderPatternImage(model, *view); !ok) {
+      return std::unexpected(name + ok.error().message);
+    }
+    auto& state = projectors_[p];
+    state.centre = toVec(lens::centre(model));
+    state.light.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      state.light[i] = {static_cast<float>(pattern[i].r) / 255.0F,
+                        static_cast<float>(pattern[i].g) / 255.0F,
+                        static_cast<float>(pattern[i].b) / 255.0F};
+    }
+    detail::gaussianBlur(state.light, model.width, model.height,
+                         scene_.lighting.projectorDefocusSigmaPx, detail::Border::kBlack);
+  }
+  return {};
+}
+
+std::expected<void, std::string> EmbreeRenderer::initGeometry() {
+  device_.reset(rtcNewDevice(nullptr));
+  if (!device_) {
+    return std::unexpected("Embree: cannot create a device (error " +
+                           std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
+  }
+  rtcSetDeviceErrorFunction(
+      device_.get(),
+      [](void* user, RTCError code, const char* text) {
+        auto& error = *static_cast<std::string*>(user);
+        if (error.empty()) {
+          error = "Embree error " + std::to_string(static_cast<int>(code)) + ": " +
+                  (text != nullptr ? text : "");
+        }
+      },
+      &embreeError_);
+
+  for (const auto& o : scene_.objects) {
+    anyMotion_ = anyMotion_ || moves(o.motion);
+  }
+  world_.reset(rtcNewScene(device_.get()));
+  rtcSetSceneFlags(world_.get(), anyMotion_ ? (RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC)
+                                            : RTC_SCENE_FLAG_ROBUST);
+
+  objects_.resize(scene_.objects.size());  // never resized again: callbacks point into it
+  for (std::size_t i = 0; i < objects_.size(); ++i) {
+    auto& state = objects_[i];
+    state.object = &scene_.objects[i];
+    state.pose = poseAt(*state.object, 0);
+    if (const auto* mesh = std::get_if<Mesh>(&state.object->shape)) {
+      // Triangles in local coordinates, built once; per frame only the instance moves.
+      state.meshScene.reset(rtcNewScene(device_.get()));
+      rtcSetSceneFlags(state.meshScene.get(), RTC_SCENE_FLAG_ROBUST);
+      rtcSetSceneBuildQuality(state.meshScene.get(), RTC_BUILD_QUALITY_HIGH);
+      const GeometryHandle triangles(rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE));
+      auto* vertices = static_cast<float*>(
+          rtcSetNewGeometryBuffer(triangles.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                  3 * sizeof(float), mesh->vertices.size()));
+      auto* indices = static_cast<std::uint32_t*>(
+          rtcSetNewGeometryBuffer(triangles.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                  3 * sizeof(std::uint32_t), mesh->triangles.size()));
+      if (vertices == nullptr || indices == nullptr) {
+        return std::unexpected("objects[" + std::to_string(i) + "]: Embree: " + embreeError_);
+      }
+      for (std::size_t v = 0; v < mesh->vertices.size(); ++v) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          vertices[3 * v + c] = mesh->vertices[v][static_cast<Eigen::Index>(c)];
+        }
+      }
+      for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          indices[3 * t + c] = mesh->triangles[t][c];
+        }
+      }
+      rtcCommitGeometry(triangles.get());
+      rtcAttachGeometry(state.meshScene.get(), triangles.get());
+      rtcCommitScene(state.meshScene.get());
+      state.geometry.reset(rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_INSTANCE));
+      rtcSetGeometryInstancedScene(state.geometry.get(), state.meshScene.get());
+      setInstanceTransform(state.geometry.get(), state.pose);
+    } else {
+      const int count = detail::surfaceCount(state.object->shape);
+      for (int s = 0; s < count; ++s) {
+        state.surfaces.push_back(detail::surfaceOf(state.object->shape, s));
+      }
+      state.geometry.reset(rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER));
+      rtcSetGeometryUserPrimitiveCount(state.geometry.get(), static_cast<unsigned>(count));
+      rtcSetGeometryUserData(state.geometry.get(), &state);
+      rtcSetGeometryBoundsFunction(state.geometry.get(), surfaceBoundsCallback, nullptr);
+      rtcSetGeometryIntersectFunction(state.geometry.get(), surfaceIntersectCallback);
+      rtcSetGeometryOccludedFunction(state.geometry.get(), surfaceOccludedCallback);
+    }
+    rtcSetGeometryMask(state.geometry.get(), kAllGeometry);
+    rtcCommitGeometry(state.geometry.get());
+    rtcAttachGeometryByID(world_.get(), state.geometry.get(), static_cast<unsigned>(i));
+  }
+  rtcCommitScene(world_.get());
+  if (!embreeError_.empty()) {
+    return std::unexpected(embreeError_);
+  }
+  return {};
+}
+
+void EmbreeRenderer::setFrame(int frame) {
+  if (frame == frame_ || !anyMotion_) {
+    return;
+  }
+  for (auto& state : objects_) {
+    if (!moves(state.object->motion)) {
+      continue;
+    }
+    state.pose = poseAt(*state.object, frame);
+    if (state.meshScene) {
+      setInstanceTransform(state.geometry.get(), state.pose);
+    }
+    rtcCommitGeometry(state.geometry.get());  // user geometries: bounds read the new pose
+  }
+  rtcCommitScene(world_.get());
+  frame_ = frame;
+}
+
+std::optional<SurfacePoint> EmbreeRenderer::trace(const Vec3& origin, const Vec3& dir) const {
+  RTCIntersectContext context{};
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = static_cast<float>(origin.x());
+  rh.ray.org_y = static_cast<float>(origin.y());
+  rh.ray.org_z = static_cast<float>(origin.z());
+  rh.ray.dir_x = static_cast<float>(dir.x());
+  rh.ray.dir_y = static_cast<float>(dir.y());
+  rh.ray.dir_z = static_cast<float>(dir.z());
+  rh.ray.tnear = 0.0F;
+  rh.ray.tfar = INFINITY;
+  rh.ray.time = 0.0F;
+  rh.ray.mask = kAllGeometry;
+  rh.ray.flags = 0;
+  rh.hit.geomID = kInvalidId;
+  rh.hit.instID[0] = kInvalidId;
+  rtcIntersect1(world_.get(), &context, &rh);
+  if (rh.hit.geomID == kInvalidId) {
+    return std::nullopt;
+  }
+  // Embree found which surface the float ray hits first; the point and normal are recomputed
+  // from the double ray on that surface (docs/simulator.md, "Precision").
+  SurfacePoint s;
+  s.object = rh.hit.instID[0] != kInvalidId ? rh.hit.instID[0] : rh.hit.geomID;
+  const ObjectState& state = objects_[s.object];
+  const double tEmbree = rh.ray.tfar;
+  if (const auto* mesh = std::get_if<Mesh>(&state.object->shape)) {
+    const auto& tri = mesh->triangles[rh.hit.primID];
+    const Vec3 a = state.pose.toWorld(mesh->vertices[tri[0]].cast<double>());
+    const Vec3 b = state.pose.toWorld(mesh->vertices[tri[1]].cast<double>());
+    const Vec3 c = state.pose.toWorld(mesh->vertices[tri[2]].cast<double>());
+    const Vec3 n = (b - a).cross(c - a);
+    const double denominator = n.dot(dir);
+    const double t = denominator != 0.0 ? n.dot(a - origin) / denominator : tEmbree;
+    s.point = origin + (std::isfinite(t) ? t : tEmbree) * dir;
+    s.normal = n.squaredNorm() > 0.0
+                   ? n.normalized()
+                   : (state.pose.R * Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)).normalized();
+  } else {
+    const detail::LocalHit hit =
+        detail::refineSurface(state.surfaces[rh.hit.primID], state.pose.toLocal(origin),
+                              state.pose.directionToLocal(dir), tEmbree);
+    s.point = origin + hit.t * dir;
+    s.normal = (state.pose.R * hit.normal).normalized();
+  }
+  if (s.normal.dot(dir) > 0.0) {
+    s.normal = -s.normal;  // two-sided: the side the ray comes from
+  }
+  return s;
+}
+
+bool EmbreeRenderer::occluded(const Vec3& from, const Vec3& to) const {
+  const Vec3 d = to - from;
+  const double length = d.norm();
+  const Vec3 dir = d / length;
+  RTCIntersectContext context{};
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = static_cast<float>(from.x());
+  ray.org_y = static_cast<float>(from.y());
+  ray.org_z = static_cast<float>(from.z());
+  ray.dir_x = static_cast<float>(dir.x());
+  ray.dir_y = static_cast<float>(dir.y());
+  ray.dir_z = static_cast<float>(dir.z());
+  ray.tnear = 0.0F;
+  ray.tfar = static_cast<float>(length);
+  ray.time = 0.0F;
+  ray.mask = kAllGeometry;
+  ray.flags = 0;
+  rtcOccluded1(world_.get(), &context, &ray);
+  return ray.tfar < 0.0F;  // Embree sets tfar = −inf when something is in the way
+}
+
+std::optional<Illumination> EmbreeRenderer::illuminate(std::size_t p, const SurfacePoint& s) const {
+  const auto& model = rig_.projectors[p];
+  const ProjectorState& projector = projectors_[p];
+  const Vec3 toProjector = projector.centre - s.point;
+  Illumination il;
+  il.distanceM = toProjector.norm();
+  il.cosTheta = s.normal.dot(toProjector) / il.distanceM;
+  if (!(il.cosTheta > 0.0)) {
+    return std::nullopt;  // the projector is behind the surface the camera sees
+  }
+  const auto uv = lens::project(model, {s.point.x(), s.point.y(), s.point.z()});
+  // Square pixels: the pixel whose centre is nearest, inside [−½, W−½) × [−½, H−½).
+  if (!uv || !inHalfOpen(uv->x, -0.5, model.width - 0.5) ||
+      !inHalfOpen(uv->y, -0.5, model.height - 0.5)) {
+    return std::nullopt;
+  }
+  il.u = uv->x;
+  il.v = uv->y;
+  const int col = std::min(static_cast<int>(std::floor(il.u + 0.5)), model.width - 1);
+  const int row = std::min(static_cast<int>(std::floor(il.v + 0.5)), model.height - 1);
+  il.pixel = pixelIndex(col, row, model.width);
+  if (occluded(s.point + kShadowOffsetM * s.normal, projector.centre)) {
+    return std::nullopt;
+  }
+  return il;
+}
+
+Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& lit) const {
+  const auto& lighting = scene_.lighting;
+  Vec3 irradiance = lighting.ambient;
+  for (std::size_t p = 0; p < projectors_.size(); ++p) {
+    if (!lit[p]) {
+      continue;
+    }
+    const auto il = illuminate(p, s);
+    if (!il) {
+      continue;
+    }
+    double w = lighting.projectorPower * il->cosTheta;
+    if (lighting.inverseSquare) {
+      const double ratio = lighting.referenceDistanceM / il->distanceM;
+      w *= ratio * ratio;
+    }
+    const RgbF& c = projectors_[p].light[il->pixel];
+    irradiance += w * Vec3(c[0], c[1], c[2]);
+  }
+  const ObjectState& state = objects_[s.object];
+  const Albedo& albedo = state.object->albedo;
+  if (std::holds_alternative<std::monostate>(albedo.texture)) {
+    return albedo.rgb.cwiseProduct(irradiance);
+  }
+  return albedoAt(albedo, state.pose.toLocal(s.point)).cwiseProduct(irradiance);
+}
+
+void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
+  const algo::Camera& camera = *ctx.camera;
+  const Vec3 centre = toVec(lens::centre(camera));
+  const double perSample =
+      1.0 / static_cast<double>(ctx.sampleOffsets.size() * ctx.sampleOffsets.size());
+  const Mat3 response = scene_.camera.gain * 255.0 * scene_.camera.crosstalk;
+  for (int x = 0; x < camera.width; ++x) {
+    Vec3 sum = Vec3::Zero();
+    std::size_t sample =
+        pixelIndex(x, y, camera.width) * ctx.sampleOffsets.size() * ctx.sampleOffsets.size();
+    for (const double dy : ctx.sampleOffsets) {
+      for (const double dx : ctx.sampleOffsets) {
+        Vec3 dir = Vec3::Constant(NAN);
+        if (ctx.sampleRays != nullptr) {
+          const RgbF& d = (*ctx.sampleRays)[sample++];
+          dir = {d[0], d[1], d[2]};
+        } else if (const auto ray = lens::pixelRay(camera, {x + dx, y + dy})) {
+          dir = toVec(ray->direction);
+        }
+        if (!dir.allFinite()) {
+          continue;  // beyond the range of the distortion model
+        }
+        if (const auto s = trace(centre, dir)) {
+          sum += radiance(*s, *ctx.lit);
+        }
+      }
+    }
+    const Vec3 grey = response * (perSample * sum);
+    linear_[pixelIndex(x, y, camera.width)] = {
+        static_cast<float>(grey.x()), static_cast<float>(grey.y()), static_cast<float>(grey.z())};
+    if (ctx.truth != nullptr) {
+      writeTruth(ctx, x, y);
+    }
+  }
+}
+
+void EmbreeRenderer::writeTruth(const FrameContext& ctx, int x, int y) const {
+  const algo::Camera& camera = *ctx.camera;
+  GroundTruthViews& truth = *ctx.truth;
+  const auto ray = lens::pixelRay(camera, {static_cast<double>(x), static_cast<double>(y)});
+  const auto s = ray ? trace(toVec(ray->origin), toVec(ray->direction)) : std::nullopt;
+  if (!truth.depth.empty()) {
+    truth.depth(x, y) = s ? static_cast<float>(lens::toDevice(
+                                camera, {s->point.x(), s->point.y(), s->point.z()})[2])
+                          : kNaN;
+  }
+  if (!truth.normal.empty()) {
+    truth.normal(x, y) = s ? std::array<float, 3>{static_cast<float>(s->normal.x()),
+                                                  static_cast<float>(s->normal.y()),
+                                                  static_cast<float>(s->normal.z())}
+                           : std::array<float, 3>{kNaN, kNaN, kNaN};
+  }
+  for (std::size_t p = 0; p < truth.projectors.size(); ++p) {
+    std::uint8_t mask = 0;
+    double u = NAN;
+    double v = NAN;
+    double stripe = NAN;
+    if (const auto il = s ? illuminate(p, *s) : std::nullopt) {
+      const auto& model = rig_.projectors[p];
+      mask = 255;
+      u = il->u;
+      v = il->v;
+      stripe = algo::stripeCoordinate(model.pattern, model.width, model.height, u, v);
+    }
+    const ProjectorTruthViews& views = truth.projectors[p];
+    if (!views.litMask.empty()) {
+      views.litMask(x, y) = mask;
+    }
+    if (!views.u.empty()) {
+      views.u(x, y) = static_cast<float>(u);
+    }
+    if (!views.v.empty()) {
+      views.v(x, y) = static_cast<float>(v);
+    }
+    if (!views.stripe.empty()) {
+      views.stripe(x, y) = static_cast<float>(stripe);
+    }
+  }
+}
+
+void EmbreeRenderer::addNoiseAndQuantise(const FrameRequest& request, algo::RgbView image) const {
+  const Vec3& sigma = scene_.camera.noiseSigma;
+  const bool noisy = (sigma.array() > 0.0).any();
+  // One stream per (seed, frame, camera), drawn in raster order after shading: the image does
+  // not depend on how rows were shared between threads.
+  std::seed_seq seeds{static_cast<std::uint32_t>(request.seed & 0xFFFFFFFFU),
+                      static_cast<std::uint32_t>(request.seed >> 32U),
+                      static_cast<std::uint32_t>(request.frame),
+                      static_cast<std::uint32_t>(request.camera)};
+  std::mt19937_64 rng(seeds);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const RgbF& in = linear_[pixelIndex(x, y, image.width())];
+      std::array<std::uint8_t, 3> out{};
+      for (std::size_t c = 0; c < 3; ++c) {
+        double level = in[c];
+        if (noisy) {
+          level += sigma[static_cast<Eigen::Index>(c)] * gauss(rng);
+        }
+        level = level > 0.0 ? std::min(level, 255.0) : 0.0;
+        out[c] = static_cast<std::uint8_t>(std::floor(level + 0.5));
+      }
+      image(x, y) = algo::Rgb8{out[0], out[1], out[2]};
+    }
+  }
+}
+
+std::expected<void, std::string> EmbreeRenderer::check(const FrameRequest& request,
+                                                       algo::RgbView image,
+                                                       const GroundTruthViews* truth) const {
+  if (request.camera < 0 || static_cast<std::size_t>(request.camera) >= rig_.cameras.size()) {
+    return std::unexpected("camera index " + std::to_string(request.camera) +
+                           " is out of range; the rig has " + std::to_string(rig_.cameras.size()) +
+                           " camera(s)");
+  }
+  const auto& camera = rig_.cameras[static_cast<std::size_t>(request.camera)];
+  const std::string size = std::to_string(camera.width) + "x" + std::to_string(camera.height);
+  const auto wrongSize = [&](const auto& view) {
+    return view.width() != camera.width || view.height() != camera.height;
+  };
+  const auto wrongTruth = [&](const auto& view) { return !view.empty() && wrongSize(view); };
+  if (wrongSize(image)) {
+    return std::unexpected("image is " + std::to_string(image.width()) + "x" +
+                           std::to_string(image.height()) + ", camera " + camera.id + " is " +
+                           size);
+  }
+  if (request.lit.size() != rig_.projectors.size()) {
+    return std::unexpected("lit has " + std::to_string(request.lit.size()) +
+                           " entries; the rig has " + std::to_string(rig_.projectors.size()) +
+                           " projector(s)");
+  }
+  if (truth == nullptr) {
+    return {};
+  }
+  if (wrongTruth(truth->depth) || wrongTruth(truth->normal)) {
+    return std::unexpected("ground-truth depth/normal view is not the camera's size " + size);
+  }
+  if (!truth->projectors.empty() && truth->projectors.size() != rig_.projectors.size()) {
+    return std::unexpected("ground truth has " + std::to_string(truth->projectors.size()) +
+                           " projector entries; the rig has " +
+                           std::to_string(rig_.projectors.size()));
+  }
+  for (std::size_t p = 0; p < truth->projectors.size(); ++p) {
+    const auto& v = truth->projectors[p];
+    if (wrongTruth(v.litMask) || wrongTruth(v.u) || wrongTruth(v.v) || wrongTruth(v.stripe)) {
+      return std::unexpected("ground truth of projectors[" + std::to_string(p) +
+                             "]: a view is not the camera's size " + size);
+    }
+  }
+  return {};
+}
+
+const std::vector<RgbF>* EmbreeRenderer::sampleRays(const FrameContext& ctx, int cameraIndex) {
+  const algo::Camera& camera = *ctx.camera;
+  const std::size_t perPixel = ctx.sampleOffsets.size() * ctx.sampleOffsets.size();
+  const std::size_t count = pixelIndex(0, camera.height, camera.width) * perPixel;
+  if (count * sizeof(RgbF) > kMaxRayTableBytes) {
+    return nullptr;
+  }
+  sampleRays_.resize(rig_.cameras.size());
+  auto& table = sampleRays_[static_cast<std::size_t>(cameraIndex)];
+  if (table.size() == count) {
+    return &table;
+  }
+  // Undistorting is a Newton iteration per ray; a static camera's rays are the same every frame.
+  // Float directions are ~1e-7 rad off, far below a sample's footprint; the ground truth uses
+  // the exact double ray of each pixel centre instead.
+  table.assign(count, RgbF{NAN, NAN, NAN});
+  forEachRow(camera.height, [&](int y) {
+    std::size_t sample = pixelIndex(0, y, camera.width) * perPixel;
+    for (int x = 0; x < camera.width; ++x) {
+      for (const double dy : ctx.sampleOffsets) {
+        for (const double dx : ctx.sampleOffsets) {
+          if (const auto ray = lens::pixelRay(camera, {x + dx, y + dy})) {
+            table[sample] = {static_cast<float>(ray->direction[0]),
+                             static_cast<float>(ray->direction[1]),
+                             static_cast<float>(ray->direction[2])};
+          }
+          ++sample;
+        }
+      }
+    }
+  });
+  return &table;
+}
+
+std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& request,
+                                                        algo::RgbView image,
+                                                        GroundTruthViews* truth) {
+  if (auto ok = check(request, image, truth); !ok) {
+    return ok;
+  }
+  setFrame(request.frame);
+  FrameContext ctx;
+  ctx.camera = &rig_.cameras[static_cast<std::size_t>(request.camera)];
+  ctx.lit = &request.lit;
+  ctx.truth = truth;
+  const int n = scene_.supersampling;
+  for (int i = 0; i < n; ++i) {
+    ctx.sampleOffsets.push_back((i + 0.5) / n - 0.5);
+  }
+  ctx.sampleRays = sampleRays(ctx, request.camera);
+  const int width = ctx.camera->width;
+  const int height = ctx.camera->height;
+  linear_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), RgbF{});
+  forEachRow(height, [&](int y) { shadeRow(ctx, y); });
+  detail::gaussianBlur(linear_, width, height, scene_.camera.defocusSigmaPx,
+                       detail::Border::kClampToEdge);
+  addNoiseAndQuantise(request, image);
+  return {};
+}
+
+}  // namespace
+
+std::expected<std::unique_ptr<Renderer>, std::string> Renderer::create(const algo::Rig& rig,
+                                                                       const Scene& scene) {
+  auto renderer = std::make_unique<EmbreeRenderer>(rig, scene);
+  if (auto ok = renderer->init(); !ok) {
+    return std::unexpected(ok.error());
+  }
+  return std::unique_ptr<Renderer>(std::move(renderer));
+}
+
+}  // namespace smx::sim

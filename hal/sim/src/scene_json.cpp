@@ -2,19 +2,14 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
-#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -23,6 +18,12 @@
 #include <variant>
 #include <vector>
 
+#include "smx/config/json_errors.hpp"
+#include "smx/config/json_keys.hpp"
+#include "smx/config/json_paths.hpp"
+#include "smx/config/json_reader.hpp"
+#include "smx/config/json_text.hpp"
+#include "smx/config/rotation_check.hpp"
 #include "smx/sim/mesh_io.hpp"
 #include "smx/sim/png_io.hpp"
 
@@ -31,15 +32,14 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using Keys = std::span<const std::string_view>;
+using config::describe;
+using config::element;
+using config::formatNumber;
+using config::jsonQuote;
+using config::Keys;
+using config::member;
 
-constexpr double kRotationTolerance = 1e-6;  // as rig.json: R printed with 7 digits passes
-constexpr int kMaxSupersampling = 8;         // 64 rays per pixel: beyond that, render larger
-// A scene.json is a few kB and 7 levels deep (objects[i].albedo.checker.colours[j]). The bounds
-// keep a mistaken input (a mesh or an image given as the scene) from costing much.
-constexpr std::size_t kMaxSceneBytes = std::size_t{1} << 20U;
-constexpr std::size_t kMaxNesting = 16;
-constexpr std::size_t kNestingNeeded = 7;
+constexpr int kMaxSupersampling = 8;  // 64 rays per pixel: beyond that, render larger
 
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
                                                       "camera_response", "objects"};
@@ -87,275 +87,20 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 10> kShapeSy
     {"model", "mesh"},
 }};
 
-// --- Generic JSON diagnostics. The approach and wording of firmware/protocol/src/rig_json.cpp
-// (paths, "got ...", key suggestions, duplicate keys, overflow, nesting); candidates for a shared
-// helper. ---
-
-std::string member(const std::string& path, std::string_view key) {
-  return path.empty() ? std::string(key) : path + "." + std::string(key);
-}
-
-std::string element(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-// Shortest text that reads back to the same double; plain notation where people expect it.
-std::string formatNumber(double v) {
-  if (!std::isfinite(v)) {
-    return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
-  }
-  const double magnitude = std::abs(v);
-  const bool plain = magnitude == 0 || (magnitude >= 1e-4 && magnitude < 1e16);
-  std::array<char, 64> buf{};
-  const auto r =
-      plain ? std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::fixed)
-            : std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return {buf.data(), r.ptr};
-}
-
-// Measured deviations: three significant digits are plenty.
-std::string formatDeviation(double v) {
-  std::array<char, 32> buf{};
-  const auto r =
-      std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::general, 3);
-  return {buf.data(), r.ptr};
-}
-
-std::string jsonQuote(std::string_view s) {
-  return Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
-}
-
-// "a string ("800")", "an array of 8 elements", ... for "got ..." in wrong-type messages.
-std::string describe(const Json& v) {
-  constexpr std::size_t kMaxShown = 40;
-  switch (v.type()) {
-    case Json::value_t::null:
-      return "null";
-    case Json::value_t::boolean:
-      return std::string("a boolean (") + (v.get<bool>() ? "true" : "false") + ")";
-    case Json::value_t::string: {
-      const auto& s = v.get_ref<const std::string&>();
-      return "a string (" +
-             (s.size() <= kMaxShown ? jsonQuote(s) : jsonQuote(s.substr(0, kMaxShown)) + "...") +
-             ")";
-    }
-    case Json::value_t::object:
-      return "an object";
-    case Json::value_t::array:
-      return "an array of " + std::to_string(v.size()) + (v.size() == 1 ? " element" : " elements");
-    case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned:
-    case Json::value_t::number_float:
-      return "a number (" + formatNumber(v.get<double>()) + ")";
-    case Json::value_t::binary:
-    case Json::value_t::discarded:
-      break;
-  }
-  return "an unexpected value";
-}
-
-std::string joined(Keys words) {
-  std::string out;
-  for (const auto w : words) {
-    out += (out.empty() ? "" : ", ") + std::string(w);
-  }
-  return out;
-}
-
-std::size_t editDistance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) {
-    row[j] = j;
-  }
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0U : 1U)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-bool equalIgnoringCase(std::string_view a, std::string_view b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](char x, char y) {
-    return std::tolower(static_cast<unsigned char>(x)) ==
-           std::tolower(static_cast<unsigned char>(y));
-  });
-}
-
-// The allowed word the user probably meant ("color" -> "colours" is too far, "colors" ->
-// "colours" is not), or empty when nothing is close enough to be a useful hint.
-std::string_view closestWord(std::string_view word, Keys allowed) {
-  std::string_view best;
-  std::size_t bestDistance = 3;  // within two edits ...
-  for (const auto candidate : allowed) {
-    if (equalIgnoringCase(word, candidate)) {
-      return candidate;
-    }
-    const bool prefix = std::min(word.size(), candidate.size()) >= 3 &&
-                        (word.starts_with(candidate) || candidate.starts_with(word));
-    const std::size_t d = prefix ? 1 : editDistance(word, candidate);
-    if (d < bestDistance && 2 * d < word.size()) {  // ... and fewer than half the word
-      best = candidate;
-      bestDistance = d;
-    }
-  }
-  return best;
-}
-
-// The first key of `obj` that is not allowed.
-std::optional<std::string> unknownKey(const Json& obj, Keys allowed) {
-  for (const auto& [key, value] : obj.items()) {
-    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-      return key;
-    }
-  }
-  return std::nullopt;
-}
-
-std::string unknownKeyProblem(std::string_view key, Keys allowed, const std::string& hint = {}) {
-  std::string problem = "unknown key " + jsonQuote(key);
-  if (!hint.empty()) {
-    problem += " (" + hint + ")";
-  } else if (const auto guess = closestWord(key, allowed); !guess.empty()) {
-    problem += " (did you mean " + jsonQuote(guess) + "?)";
-  }
-  return problem + "; allowed keys: " + joined(allowed);
-}
-
-// Follows the JSON path while nlohmann parses, for what nlohmann does not report by path: a
-// duplicated key (nlohmann keeps the last copy silently) and a number too large for a double.
-class ParseTracker {
- public:
-  bool onEvent(Json::parse_event_t event, const Json& parsed) {
-    using E = Json::parse_event_t;
-    switch (event) {
-      case E::object_start:
-      case E::array_start:
-        valueStarts();
-        stack_.push_back({event == E::array_start, 0, {}, {}});
-        break;
-      case E::object_end:
-      case E::array_end:
-        stack_.pop_back();
-        break;
-      case E::key:
-        if (!stack_.empty()) {
-          Frame& f = stack_.back();
-          f.key = parsed.get<std::string>();
-          if (!f.keys.insert(f.key).second && !duplicate_) {
-            duplicate_ = SceneError{{},
-                                    pathTo(stack_.size() - 1),
-                                    "key " + jsonQuote(f.key) + " appears more than once"};
-          }
-        }
-        break;
-      case E::value:
-        valueStarts();
-        break;
-    }
-    return true;
-  }
-
-  [[nodiscard]] const std::optional<SceneError>& duplicate() const { return duplicate_; }
-
-  // The path of the value being read now (the one that made nlohmann stop).
-  [[nodiscard]] std::string currentPath() const {
-    if (stack_.empty()) {
-      return {};
-    }
-    const Frame& f = stack_.back();
-    const std::string parent = pathTo(stack_.size() - 1);
-    return f.isArray ? element(parent, f.count) : member(parent, f.key);
-  }
-
- private:
-  struct Frame {
-    bool isArray;
-    std::size_t count;  // elements started so far (arrays)
-    std::string key;    // key being read (objects)
-    std::set<std::string, std::less<>> keys;
-  };
-
-  void valueStarts() {
-    if (!stack_.empty() && stack_.back().isArray) {
-      ++stack_.back().count;
-    }
-  }
-
-  // Path of the container held by stack_[depth].
-  [[nodiscard]] std::string pathTo(std::size_t depth) const {
-    std::string path;
-    for (std::size_t i = 0; i < depth; ++i) {
-      const Frame& f = stack_[i];
-      path = f.isArray ? element(path, f.count - 1) : member(path, f.key);
-    }
-    return path;
-  }
-
-  std::vector<Frame> stack_;
-  std::optional<SceneError> duplicate_;
-};
-
-std::string parseErrorProblem(std::string_view what) {
-  // "[json.exception.parse_error.101] parse error at line 2, column 5: syntax error ..."
-  if (const auto close = what.find("] "); close != std::string_view::npos) {
-    what.remove_prefix(close + 2);
-  }
-  constexpr std::string_view kLead = "parse error at ";
-  if (what.starts_with(kLead)) {
-    what.remove_prefix(kLead.size());
-  }
-  // The parser quotes the bytes it last read, which may be anything; keep the message printable.
-  std::string problem = "not valid JSON: " + std::string(what);
-  std::replace_if(
-      problem.begin(), problem.end(),
-      [](char c) {
-        const auto byte = static_cast<unsigned char>(c);
-        return byte < 0x20 || byte >= 0x7f;
-      },
-      '?');
-  return problem;
-}
-
-// "[json.exception.out_of_range.406] number overflow parsing '1e999'" -> "1e999"
-std::string overflowedLiteral(std::string_view what) {
-  const auto open = what.find('\'');
-  const auto close = what.rfind('\'');
-  if (open == std::string_view::npos || close <= open) {
-    return "the number";
-  }
-  return std::string(what.substr(open + 1, close - open - 1));
-}
-
-// Deepest [ / { nesting outside strings; checked before nlohmann builds anything.
-std::size_t nestingDepth(std::string_view text) {
-  std::size_t depth = 0;
-  std::size_t deepest = 0;
-  bool inString = false;
-  bool escaped = false;
-  for (const char c : text) {
-    if (inString) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        inString = false;
-      }
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return deepest;
-}
+// A rig.json given as the scene is named as such.
+constexpr std::array<config::FormatHint, 1> kOtherFormats = {
+    {{"stripemux-rig/", " (this is a rig.json, not a scene)"}}};
+// A scene.json is a few kB and 7 levels deep (objects[i].albedo.checker.colours[j]). The bounds
+// keep a mistaken input (a mesh or an image given as the scene) from costing much.
+constexpr config::DocumentSpec kSceneDocument = {
+    .name = "scene.json",
+    .format = kSceneFormat,
+    .topKeys = kTopKeys,
+    .maxBytes = std::size_t{1} << 20U,
+    .sizeNote = " (meshes and textures go in their own files)",
+    .nestingNeeded = 7,
+    .maxNesting = 16,
+    .otherFormats = kOtherFormats};
 
 // --- Reading scene values ---
 
@@ -386,8 +131,8 @@ class Reader {
       fail(path, "must be an object (" + std::string(what) + "), got " + describe(v));
       return false;
     }
-    if (const auto key = unknownKey(v, allowed)) {
-      fail(path, unknownKeyProblem(*key, allowed));
+    if (const auto key = config::unknownKey(v, allowed)) {
+      fail(path, config::unknownKeyProblem(*key, allowed));
       return false;
     }
     return true;
@@ -564,18 +309,9 @@ Mat3 rotationFromDegrees(const Vec3& deg) {
 }
 
 void checkRotation(Reader& r, const Mat3& rotation, const std::string& path) {
-  const double deviation =
-      (rotation * rotation.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff();
-  if (!(deviation <= kRotationTolerance)) {
-    r.fail(path, "not a rotation: max |R*R^T - I| is " + formatDeviation(deviation) +
-                     " (must be at most " + formatDeviation(kRotationTolerance) + ")");
-    return;
-  }
-  const double det = rotation.determinant();
-  if (!(std::abs(det - 1) <= kRotationTolerance)) {
-    r.fail(path, "not a rotation: det R is " + formatDeviation(det) + " (must be 1 within " +
-                     formatDeviation(kRotationTolerance) +
-                     (det < 0 ? "; det -1 is a reflection)" : ")"));
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rowMajor = rotation;
+  if (auto problem = config::rotationProblem(std::span<const double, 9>(rowMajor.data(), 9))) {
+    r.fail(path, std::move(*problem));
   }
 }
 
@@ -651,7 +387,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
   }
   std::string_view guess;
   for (const auto& [word, type] : kShapeSynonyms) {
-    if (equalIgnoringCase(word, name)) {
+    if (config::equalIgnoringCase(word, name)) {
       guess = type;
     }
   }
@@ -659,7 +395,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
     std::array<std::string_view, kShapeTypes.size()> names{};
     std::transform(kShapeTypes.begin(), kShapeTypes.end(), names.begin(),
                    [](const ShapeType& t) { return t.name; });
-    guess = closestWord(name, names);
+    guess = config::closestWord(name, names);
   }
   r.fail(at, "unknown shape type " + jsonQuote(name) +
                  (guess.empty() ? "" : " (did you mean " + jsonQuote(guess) + "?)") +
@@ -683,8 +419,8 @@ void readShape(Reader& r, const Json& obj, const std::string& objectPath, Shape&
   if (type == nullptr) {
     return;
   }
-  if (const auto key = unknownKey(*v, type->keys)) {
-    r.fail(path, unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
+  if (const auto key = config::unknownKey(*v, type->keys)) {
+    r.fail(path, config::unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
     return;
   }
   if (type->name == "plane") {
@@ -972,83 +708,15 @@ void readObjects(Reader& r, const Json& doc, const fs::path& baseDir, Scene& sce
   }
 }
 
-std::optional<SceneError> checkFormat(const Json& doc) {
-  const std::string supported = "supported: " + jsonQuote(kSceneFormat);
-  const auto it = doc.find("format");
-  if (it == doc.end()) {
-    return SceneError{{},
-                      "format",
-                      "required field is missing; a scene.json starts with \"format\": " +
-                          jsonQuote(kSceneFormat)};
-  }
-  if (!it->is_string()) {
-    return SceneError{
-        {},
-        "format",
-        "must be a string such as " + jsonQuote(kSceneFormat) + ", got " + describe(*it)};
-  }
-  const auto& format = it->get_ref<const std::string&>();
-  if (format == kSceneFormat) {
-    return std::nullopt;
-  }
-  if (format.starts_with("stripemux-scene/")) {
-    return SceneError{{}, "format", "unsupported version " + jsonQuote(format) + "; " + supported};
-  }
-  const std::string hint =
-      format.starts_with("stripemux-rig/") ? " (this is a rig.json, not a scene)" : "";
-  return SceneError{{}, "format", "unknown format " + jsonQuote(format) + hint + "; " + supported};
-}
-
-std::unexpected<SceneError> failDocument(std::string problem) {
-  return std::unexpected(SceneError{{}, {}, std::move(problem)});
-}
-
 std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs::path& baseDir) {
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
-    return failDocument(
-        "not valid JSON: the text is empty; a scene.json is a JSON object {\"format\": ...}");
+  auto parsed = config::parseDocument(text, kSceneDocument);
+  if (!parsed) {
+    auto& e = parsed.error();
+    return std::unexpected(SceneError{{}, std::move(e.field), std::move(e.problem)});
   }
-  if (text.size() > kMaxSceneBytes) {
-    return failDocument("the text is " + std::to_string(text.size()) +
-                        " bytes; a scene.json is at most " + std::to_string(kMaxSceneBytes) +
-                        " bytes (meshes and textures go in their own files)");
-  }
-  if (const auto depth = nestingDepth(text); depth > kMaxNesting) {
-    return failDocument("nested " + std::to_string(depth) + " levels deep; a scene.json needs " +
-                        std::to_string(kNestingNeeded) + " and at most " +
-                        std::to_string(kMaxNesting) + " are accepted");
-  }
-  ParseTracker tracker;
-  Json doc;
-  try {
-    doc = Json::parse(text, [&](int, Json::parse_event_t event, Json& parsed) {
-      return tracker.onEvent(event, parsed);
-    });
-  } catch (const Json::parse_error& e) {
-    return failDocument(parseErrorProblem(e.what()));
-  } catch (const Json::out_of_range& e) {
-    // JSON has no NaN or infinity; the only non-finite number is one that overflows a double.
-    if (e.id == 406) {
-      return std::unexpected(SceneError{{},
-                                        tracker.currentPath(),
-                                        "must be a finite number; " + overflowedLiteral(e.what()) +
-                                            " is too large for a double"});
-    }
-    throw;
-  }
-  if (!doc.is_object()) {
-    return failDocument("the top level must be a JSON object {\"format\": ...}, got " +
-                        describe(doc));
-  }
-  if (auto format = checkFormat(doc)) {
-    return std::unexpected(std::move(*format));
-  }
-  if (const auto& duplicate = tracker.duplicate(); duplicate.has_value()) {
-    return std::unexpected(*duplicate);
-  }
+  const Json& doc = *parsed;
   Reader r;
   Scene scene;
-  r.object(doc, "", "", kTopKeys);
   r.integer(doc, "", "supersampling", 1, kMaxSupersampling, "samples per pixel side",
             scene.supersampling);
   readLighting(r, doc, scene.lighting);
@@ -1063,13 +731,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
 }  // namespace
 
 std::string SceneError::message() const {
-  std::string out;
-  for (const auto* part : {&file, &field, &problem}) {
-    if (!part->empty()) {
-      out += (out.empty() ? "" : ": ") + *part;
-    }
-  }
-  return out;
+  return config::errorMessage(file, field, problem);
 }
 
 std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
@@ -1078,54 +740,14 @@ std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
     return parseSceneImpl(jsonText, baseDir);
   } catch (const std::exception& e) {
     // Out of memory or a library surprise: still an error value, never an exception.
-    return failDocument(std::string("cannot read the scene: ") + e.what());
+    return std::unexpected(SceneError{{}, {}, std::string("cannot read the scene: ") + e.what()});
   }
 }
 
 std::expected<Scene, SceneError> loadScene(const std::filesystem::path& file) {
-  const auto withFile = [&](SceneError e) {
-    e.file = file.string();
-    return std::unexpected(std::move(e));
-  };
-  try {
-    std::error_code ec;
-    const auto status = fs::status(file, ec);
-    if (ec || !fs::exists(status)) {
-      return withFile(
-          {{}, {}, "cannot read the file: " + (ec ? ec.message() : std::string("no such file"))});
-    }
-    if (fs::is_directory(status)) {
-      return withFile({{}, {}, "cannot read the file: it is a directory"});
-    }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
-      return withFile(
-          {{},
-           {},
-           "cannot read the file: " + std::generic_category().message(errno != 0 ? errno : EIO)});
-    }
-    std::string text;
-    std::array<char, 4096> chunk{};
-    while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
-      text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-      if (text.size() > kMaxSceneBytes) {
-        return withFile({{},
-                         {},
-                         "file is larger than " + std::to_string(kMaxSceneBytes) +
-                             " bytes; a scene.json is a few kB"});
-      }
-    }
-    if (in.bad()) {
-      return withFile({{}, {}, "cannot read the file: read error"});
-    }
-    auto scene = parseScene(text, file.parent_path());
-    if (!scene) {
-      return withFile(std::move(scene.error()));
-    }
-    return scene;
-  } catch (const std::exception& e) {
-    return withFile({{}, {}, std::string("cannot read the file: ") + e.what()});
-  }
+  return config::loadDocument(file, kSceneDocument, [&](const std::string& text) {
+    return parseScene(text, file.parent_path());
+  });
 }
 
 }  // namespace smx::sim

@@ -1,0 +1,243 @@
+// stripemux sim --rig rig.json --scene scene.json|NAME --out DIR [--frames N] [--seed S]
+//               [--lit all|none|ID,ID...] [--no-truth]
+// Renders what each camera of the rig sees, with ground truth (docs/simulator.md, docs/cli.md).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <system_error>
+#include <vector>
+
+#include "commands.hpp"
+#include "smx/protocol/rig_json.hpp"
+#include "smx/sim/pfm_io.hpp"
+#include "smx/sim/png_io.hpp"
+#include "smx/sim/renderer.hpp"
+#include "smx/sim/scene_json.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SimOptions {
+  fs::path rig;
+  std::string scene;
+  fs::path out;
+  int frames = 1;
+  std::uint64_t seed = 1;
+  std::string lit = "all";
+  bool noTruth = false;
+};
+
+// Named scenes live in hal/sim/scenes/<name>.json; STRIPEMUX_SCENES overrides the folder.
+fs::path sceneDir() {
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): read once, before any thread exists.
+  if (const char* env = std::getenv("STRIPEMUX_SCENES"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return SMX_SCENE_DIR;
+}
+
+std::vector<std::string> namedScenes() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(sceneDir(), ec)) {
+    if (entry.path().extension() == ".json") {
+      names.push_back(entry.path().stem().string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A path if it names a file, else a named scene.
+std::expected<fs::path, std::string> resolveScene(const std::string& arg) {
+  if (fs::exists(arg) || arg.find('/') != std::string::npos || arg.ends_with(".json")) {
+    return fs::path(arg);
+  }
+  const auto named = sceneDir() / (arg + ".json");
+  if (fs::exists(named)) {
+    return named;
+  }
+  std::string known;
+  for (const auto& n : namedScenes()) {
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  return std::unexpected("--scene " + arg + ": no such file and no named scene of that name" +
+                         " (named scenes: " + known + ")");
+}
+
+std::expected<std::vector<bool>, std::string> parseLit(const std::string& spec,
+                                                       const algo::Rig& rig) {
+  std::vector<bool> lit(rig.projectors.size(), spec == "all");
+  if (spec == "all" || spec == "none") {
+    return lit;
+  }
+  std::stringstream ss(spec);
+  for (std::string id; std::getline(ss, id, ',');) {
+    bool found = false;
+    for (std::size_t i = 0; i < rig.projectors.size(); ++i) {
+      if (rig.projectors[i].id == id) {
+        lit[i] = true;
+        found = true;
+      }
+    }
+    if (!found) {
+      return std::unexpected("--lit: the rig has no projector \"" + id + "\"");
+    }
+  }
+  return lit;
+}
+
+template <class T>
+struct Plane {
+  std::vector<T> pixels;
+  algo::ImageView<T> view;
+  Plane(int w, int h, T fill)
+      : pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), fill),
+        view(*algo::ImageView<T>::packed(pixels, w, h)) {}
+};
+
+struct CameraTruth {
+  Plane<float> depth;
+  Plane<std::array<float, 3>> normal;
+  std::vector<Plane<std::uint8_t>> lit;
+  std::vector<Plane<float>> u, v, stripe;
+
+  CameraTruth(int w, int h, std::size_t projectors)
+      : depth(w, h, 0.0F), normal(w, h, std::array<float, 3>{}) {
+    for (std::size_t p = 0; p < projectors; ++p) {
+      lit.emplace_back(w, h, std::uint8_t{0});
+      u.emplace_back(w, h, 0.0F);
+      v.emplace_back(w, h, 0.0F);
+      stripe.emplace_back(w, h, 0.0F);
+    }
+  }
+
+  sim::GroundTruthViews views() {
+    sim::GroundTruthViews t{depth.view, normal.view, {}};
+    for (std::size_t p = 0; p < lit.size(); ++p) {
+      t.projectors.push_back({lit[p].view, u[p].view, v[p].view, stripe[p].view});
+    }
+    return t;
+  }
+};
+
+std::expected<void, std::string> writeTruth(CameraTruth& truth, const algo::Rig& rig,
+                                            const fs::path& dir, const std::string& camTag) {
+  if (auto r = sim::writePfm(dir / (camTag + ".depth.pfm"), truth.depth.view); !r) {
+    return r;
+  }
+  if (auto r = sim::writePfm(dir / (camTag + ".normal.pfm"), truth.normal.view); !r) {
+    return r;
+  }
+  for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
+    const auto base = rig.projectors[p].id + "." + camTag;
+    if (auto r = sim::writePngGray8(dir / (base + ".lit.png"), truth.lit[p].view); !r) {
+      return r;
+    }
+    for (const auto& [suffix, plane] :
+         {std::pair{".u.pfm", &truth.u[p]}, std::pair{".v.pfm", &truth.v[p]},
+          std::pair{".stripe.pfm", &truth.stripe[p]}}) {
+      if (auto r = sim::writePfm(dir / (base + suffix), plane->view); !r) {
+        return r;
+      }
+    }
+  }
+  return {};
+}
+
+int runSim(const SimOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux sim: " << message << "\n";
+    return code;
+  };
+  auto rig = protocol::loadRig(opts.rig);
+  if (!rig) {
+    return fail(kExitBadInput, rig.error().message());
+  }
+  const auto scenePath = resolveScene(opts.scene);
+  if (!scenePath) {
+    return fail(kExitBadInput, scenePath.error());
+  }
+  auto scene = sim::loadScene(*scenePath);
+  if (!scene) {
+    return fail(kExitBadInput, scene.error().message());
+  }
+  const auto lit = parseLit(opts.lit, *rig);
+  if (!lit) {
+    return fail(kExitUsage, lit.error());
+  }
+  auto renderer = sim::Renderer::create(*rig, *scene);
+  if (!renderer) {
+    return fail(kExitBadInput, renderer.error());
+  }
+  std::error_code ec;
+  fs::create_directories(opts.out, ec);
+  if (ec) {
+    return fail(kExitDeviceOrIo,
+                "cannot create output directory " + opts.out.string() + ": " + ec.message());
+  }
+
+  for (int frame = 0; frame < opts.frames; ++frame) {
+    for (std::size_t c = 0; c < rig->cameras.size(); ++c) {
+      const auto& camera = rig->cameras[c];
+      const std::string tag = opts.frames > 1 ? camera.id + "_" + std::to_string(frame) : camera.id;
+      const Plane<algo::Rgb8> image(camera.width, camera.height, algo::Rgb8{0, 0, 0});
+      std::unique_ptr<CameraTruth> truth;
+      sim::GroundTruthViews truthViews;
+      if (!opts.noTruth) {
+        truth = std::make_unique<CameraTruth>(camera.width, camera.height, rig->projectors.size());
+        truthViews = truth->views();
+      }
+      const sim::FrameRequest request{static_cast<int>(c), frame, *lit, opts.seed};
+      const auto start = std::chrono::steady_clock::now();
+      if (auto r = (*renderer)->render(request, image.view, truth ? &truthViews : nullptr); !r) {
+        return fail(kExitBadInput, camera.id + ": " + r.error());
+      }
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
+      const auto file = opts.out / (tag + ".png");
+      if (auto r = sim::writePngRgb8(file, image.view); !r) {
+        return fail(kExitDeviceOrIo, r.error());
+      }
+      if (truth) {
+        if (auto r = writeTruth(*truth, *rig, opts.out, tag); !r) {
+          return fail(kExitDeviceOrIo, r.error());
+        }
+      }
+      io.out << "wrote " << file.string() << "  (frame " << frame << ", " << camera.width << "x"
+             << camera.height << ", rendered in " << static_cast<int>(std::lround(ms)) << " ms"
+             << (truth ? ", with ground truth" : "") << ")\n";
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<SimOptions>();
+  auto* cmd =
+      app.add_subcommand("sim", "Render what the rig's cameras see of a scene, with ground truth");
+  cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
+  cmd->add_option("--scene", opts->scene,
+                  "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene")
+      ->required();
+  cmd->add_option("--out", opts->out, "Output directory")->required();
+  cmd->add_option("--frames", opts->frames, "Number of frames (animated scenes move)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--seed", opts->seed, "Noise seed");
+  cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list");
+  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images");
+  cmd->callback([opts, &io, &exitCode] { exitCode = runSim(*opts, io); });
+}
+
+}  // namespace smx::host
