@@ -82,4 +82,29 @@ class Arena {
   std::size_t highWater_ = 0;
 };
 
+// Sizes a sequence of allocations without memory: the same calls as Arena, returning empty spans
+// and views, and the buffer size that makes them succeed wherever the buffer starts (each
+// allocation counted with its worst-case alignment padding). Lets a stage report the scratch it
+// needs by running its own allocation code.
+class ArenaSizer {
+ public:
+  template <class T>
+  [[nodiscard]] Result<std::span<T>> allocate(std::size_t count) {
+    bytes_ += count * sizeof(T) + alignof(T) - 1;
+    return std::span<T>();
+  }
+  template <class Pixel>
+  [[nodiscard]] Result<ImageView<Pixel>> allocateImage(int width, int height) {
+    const std::size_t stride =
+        (sizeof(Pixel) * static_cast<std::size_t>(width) + Arena::kRowAlignBytes - 1) /
+        Arena::kRowAlignBytes * Arena::kRowAlignBytes;
+    bytes_ += stride * static_cast<std::size_t>(height) + Arena::kRowAlignBytes - 1;
+    return ImageView<Pixel>();
+  }
+  [[nodiscard]] std::size_t bytes() const { return bytes_; }
+
+ private:
+  std::size_t bytes_ = 0;
+};
+
 }  // namespace smx::algo

@@ -1,0 +1,126 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "smx/algo/arena.hpp"
+#include "smx/algo/boundary_map.hpp"
+#include "smx/algo/error.hpp"
+#include "smx/algo/image_view.hpp"
+
+// Orientation demultiplexing (paper §3, §4.2–4.3; docs/demux.md): from one camera image in which
+// the same colour-stripe pattern of 1–3 projectors is superposed at different orientations,
+// each projector's stripe boundaries with their colour transitions.
+//
+// Stages, all per frame, integer-only and allocation-free (src/frame/demux_*.cpp):
+//   1. binomial 3×3 smoothing of each channel (×16 fixed point);
+//   2. per tile, the magnitude-weighted histogram of doubled gradient angles over a window of
+//      tiles; its lobes, refined by a local weighted mean, are matched to each projector's
+//      predicted encoding direction (sign and identity come from the rig);
+//   3. per pixel, the directional derivative that cancels the other patterns present: along
+//      the projector's own axis (alone), perpendicular to the other axis (two patterns), or the
+//      mixed second derivative perpendicular to both others (three patterns);
+//   4. division by the locally averaged colour;
+//   5. non-maximum suppression along the encoding axis, sub-pixel position by a parabola, the
+//      transition class (from the falling and the rising channel) and a confidence.
+namespace smx::algo {
+
+inline constexpr int kMaxProjectors = 3;
+
+// Tunables, with the defaults the accuracy tests were measured with.
+struct DemuxParams {
+  int tilePx = 8;              // direction / colour-average tile size
+  int windowTiles = 3;         // histogram window: windowTiles × windowTiles tiles (odd)
+  int histogramStride = 2;     // gradients sampled every n-th pixel in x and y for the histogram
+  int minGradientGrey = 4;     // gradient magnitude (grey levels per pixel) counted in histograms
+  int lobeToleranceDeg = 25;   // a lobe is a projector's if within this of its predicted axis
+  int minLobeSharePct = 12;    // and holds at least this share of the window's weight
+  int minStrengthPermille = 80;  // boundary strength, relative to the local average colour
+  bool smooth = true;          // step 1
+  bool normaliseColour = true;  // step 4
+};
+
+// The frame geometry fixed at init: image size, projector count and each projector's predicted
+// encoding direction per tile (BinAngle raw, +axis towards growing stripe index), from
+// calibration at a nominal depth (predictEncodingAngles in encoding_prediction.hpp).
+struct DemuxLayout {
+  int width = 0;
+  int height = 0;
+  int projectors = 0;
+  DemuxParams params;
+
+  [[nodiscard]] int tilesX() const { return (width + params.tilePx - 1) / params.tilePx; }
+  [[nodiscard]] int tilesY() const { return (height + params.tilePx - 1) / params.tilePx; }
+  [[nodiscard]] std::size_t tileCount() const {
+    return static_cast<std::size_t>(tilesX()) * static_cast<std::size_t>(tilesY());
+  }
+};
+
+// What the direction stage found in one tile for one projector.
+struct TileDirection {
+  std::uint16_t angle = 0;  // BinAngle raw of the encoding direction (estimated or predicted)
+  std::uint8_t present = 0;  // 1 when the pattern's lobe was found in the tile's window
+  std::uint8_t sharePct = 0;  // the lobe's share of the window's gradient weight
+};
+
+namespace demux {
+class UnitTable;
+struct TileInterp;
+}  // namespace demux
+
+class Demultiplexer {
+ public:
+  // The most arena bytes create() takes for this layout, alignment padding included.
+  [[nodiscard]] static Result<std::size_t> workspaceBytes(const DemuxLayout& layout);
+
+  // predictedAngles: tileCount() × projectors values, tile-major (tile t, projector p at
+  // t * projectors + p); copied into the arena.
+  [[nodiscard]] static Result<Demultiplexer> create(const DemuxLayout& layout,
+                                                    std::span<const std::uint16_t> predictedAngles,
+                                                    Arena& arena);
+
+  // Per frame: every projector's boundaries and directions. The image must be width × height.
+  [[nodiscard]] Result<void> run(ConstRgbView image);
+
+  [[nodiscard]] const DemuxLayout& layout() const { return layout_; }
+  [[nodiscard]] ConstBoundaryPlane boundaries(int projector) const;
+  [[nodiscard]] ConstDirectionPlane directions(int projector) const;
+  // tileCount() entries for the projector, row-major over tiles.
+  [[nodiscard]] std::span<const TileDirection> tileDirections(int projector) const;
+
+  // Debug views of the last projector separated by run() (or by separateOnly()): its
+  // colour-normalised derivative per channel (Q4.11 of the local average colour) and the
+  // boundary strength.
+  [[nodiscard]] ImageView<const std::int16_t> separated(int channel) const;
+  [[nodiscard]] ImageView<const std::uint16_t> strength() const { return strength_; }
+  // Repeats stages 3–5 of the last run() for one projector, so that its debug views can be read.
+  [[nodiscard]] Result<void> separateOnly(int projector);
+
+ private:
+  Demultiplexer() = default;
+  template <class Carver>
+  [[nodiscard]] Result<void> carve(Carver& carver);
+
+  DemuxLayout layout_;
+  std::span<std::uint16_t> predicted_;
+  std::span<demux::UnitTable> units_;            // one table
+  std::span<demux::TileInterp> columns_;
+  std::span<demux::TileInterp> rows_;
+  std::span<std::int16_t> rowScratch_;
+  std::span<std::uint32_t> tileHistograms_;      // tileCount × 64 bins
+  std::span<std::uint16_t> sampleAngles_;        // doubled angle per histogram sample
+  std::span<std::uint16_t> sampleWeights_;       // weight per histogram sample (0: none)
+  std::span<std::uint32_t> tileColourSums_;      // tileCount × 3
+  std::span<std::uint32_t> tileInverseColour_;   // tileCount × 3: 2^24 / average
+  std::span<TileDirection> tileDirections_;      // projectors × tileCount
+  std::array<ImageView<std::int16_t>, 3> smoothed_;
+  std::array<ImageView<std::int16_t>, 3> separated_;
+  ImageView<std::uint16_t> strength_;
+  ImageView<std::uint8_t> order_;
+  std::array<BoundaryPlane, kMaxProjectors> boundaries_;
+  std::array<DirectionPlane, kMaxProjectors> directions_;
+};
+
+}  // namespace smx::algo

@@ -1,0 +1,195 @@
+// The demultiplexer: working memory carved from the arena at create() (the only place that
+// takes memory), the stages of demux_kernels.hpp run in order per frame.
+#include "smx/algo/demux.hpp"
+
+#include <cstdint>
+
+#include "demux_kernels.hpp"
+#include "smx/algo/fixed_math.hpp"
+
+namespace smx::algo {
+
+namespace demux {
+
+void UnitTable::fill() {
+  for (std::size_t i = 0; i < kEntries; ++i) {
+    cos_[i] = algo::cos(BinAngle{static_cast<std::uint16_t>(i * (65536 / kEntries))}).raw();
+  }
+}
+
+}  // namespace demux
+
+namespace {
+
+Result<void> validate(const DemuxLayout& l) {
+  const DemuxParams& p = l.params;
+  if (l.width < 8 || l.height < 8 || l.width > 8192 || l.height > 8192) {
+    return fail(Errc::kInvalidArgument, "demux: image size must be 8 to 8192 pixels per side");
+  }
+  if (l.projectors < 1 || l.projectors > kMaxProjectors) {
+    return fail(Errc::kInvalidArgument, "demux: 1 to 3 projectors");
+  }
+  if (p.tilePx < 4 || p.tilePx > 64 || p.windowTiles < 1 || p.windowTiles > 9 ||
+      p.windowTiles % 2 == 0 || p.histogramStride < 1 || p.histogramStride > 8) {
+    return fail(Errc::kInvalidArgument,
+                "demux: tilePx 4 to 64, windowTiles odd 1 to 9, histogramStride 1 to 8");
+  }
+  if (p.lobeToleranceDeg < 1 || p.lobeToleranceDeg > 45 || p.minLobeSharePct < 0 ||
+      p.minLobeSharePct > 100 || p.minGradientGrey < 0 || p.minGradientGrey > 255 ||
+      p.minStrengthPermille < 0 || p.minStrengthPermille > 16000) {
+    return fail(Errc::kInvalidArgument, "demux: a threshold is out of range");
+  }
+  return {};
+}
+
+template <class T, class Carver>
+Result<void> take(Carver& carver, std::span<T>& out, std::size_t count) {
+  auto span = carver.template allocate<T>(count);
+  if (!span) {
+    return std::unexpected(span.error());
+  }
+  out = *span;
+  return {};
+}
+
+template <class P, class Carver>
+Result<void> takeImage(Carver& carver, ImageView<P>& out, const DemuxLayout& l) {
+  auto view = carver.template allocateImage<P>(l.width, l.height);
+  if (!view) {
+    return std::unexpected(view.error());
+  }
+  out = *view;
+  return {};
+}
+
+}  // namespace
+
+template <class Carver>
+Result<void> Demultiplexer::carve(Carver& carver) {
+  const DemuxLayout& l = layout_;
+  const demux::SampleGrid grid = demux::sampleGrid(l);
+  const std::size_t tiles = l.tileCount();
+  const auto samples =
+      static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height);
+  const auto projectors = static_cast<std::size_t>(l.projectors);
+  Result<void> ok;
+  const auto step = [&ok](Result<void> r) {
+    if (ok && !r) {
+      ok = r;
+    }
+  };
+  step(take(carver, predicted_, tiles * projectors));
+  step(take(carver, units_, 1));
+  step(take(carver, columns_, static_cast<std::size_t>(l.width)));
+  step(take(carver, rows_, static_cast<std::size_t>(l.height)));
+  step(take(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
+  step(take(carver, tileHistograms_, tiles * demux::kBins));
+  step(take(carver, sampleAngles_, samples));
+  step(take(carver, sampleWeights_, samples));
+  step(take(carver, tileColourSums_, tiles * 3));
+  step(take(carver, tileInverseColour_, tiles * 3));
+  step(take(carver, tileDirections_, tiles * projectors));
+  for (auto& plane : smoothed_) {
+    step(takeImage(carver, plane, l));
+  }
+  for (auto& plane : separated_) {
+    step(takeImage(carver, plane, l));
+  }
+  step(takeImage(carver, strength_, l));
+  step(takeImage(carver, order_, l));
+  for (std::size_t p = 0; p < projectors; ++p) {
+    step(takeImage(carver, boundaries_[p], l));
+    step(takeImage(carver, directions_[p], l));
+  }
+  return ok;
+}
+
+Result<std::size_t> Demultiplexer::workspaceBytes(const DemuxLayout& layout) {
+  if (auto ok = validate(layout); !ok) {
+    return std::unexpected(ok.error());
+  }
+  Demultiplexer d;
+  d.layout_ = layout;
+  ArenaSizer sizer;
+  if (auto ok = d.carve(sizer); !ok) {
+    return std::unexpected(ok.error());
+  }
+  return sizer.bytes();
+}
+
+Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
+                                            std::span<const std::uint16_t> predictedAngles,
+                                            Arena& arena) {
+  if (auto ok = validate(layout); !ok) {
+    return std::unexpected(ok.error());
+  }
+  if (predictedAngles.size() != layout.tileCount() * static_cast<std::size_t>(layout.projectors)) {
+    return fail(Errc::kSizeMismatch, "demux: predicted angles must be tileCount x projectors");
+  }
+  Demultiplexer d;
+  d.layout_ = layout;
+  const Arena::Marker start = arena.mark();
+  if (auto ok = d.carve(arena); !ok) {
+    arena.rewind(start);
+    return std::unexpected(ok.error());
+  }
+  for (std::size_t i = 0; i < predictedAngles.size(); ++i) {
+    d.predicted_[i] = predictedAngles[i];
+  }
+  d.units_[0].fill();
+  demux::tileInterpolation(layout.width, layout.params.tilePx, layout.tilesX(), d.columns_);
+  demux::tileInterpolation(layout.height, layout.params.tilePx, layout.tilesY(), d.rows_);
+  return d;
+}
+
+Result<void> Demultiplexer::run(ConstRgbView image) {
+  if (image.width() != layout_.width || image.height() != layout_.height) {
+    return fail(Errc::kSizeMismatch, "demux: image size differs from the layout");
+  }
+  const DemuxParams& p = layout_.params;
+  demux::smoothChannels(image, smoothed_, p.smooth, rowScratch_);
+  demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
+  demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
+  demux::histogramTiles(smoothed_, layout_, sampleAngles_, sampleWeights_, tileHistograms_);
+  demux::estimateDirections(layout_, tileHistograms_, sampleAngles_, sampleWeights_, predicted_,
+                            tileDirections_);
+  for (int projector = 0; projector < layout_.projectors; ++projector) {
+    if (auto ok = separateOnly(projector); !ok) {
+      return ok;
+    }
+  }
+  return {};
+}
+
+Result<void> Demultiplexer::separateOnly(int projector) {
+  if (projector < 0 || projector >= layout_.projectors) {
+    return fail(Errc::kInvalidArgument, "demux: no such projector");
+  }
+  const auto p = static_cast<std::size_t>(projector);
+  demux::separate(smoothed_, layout_, projector, tileDirections_, tileInverseColour_, columns_,
+                  rows_, units_[0], separated_, order_, directions_[p]);
+  // Q4.11 threshold from per mille.
+  const int minStrength = (layout_.params.minStrengthPermille << demux::kRelativeShift) / 1000;
+  demux::detectBoundaries(separated_, order_, directions_[p], units_[0], minStrength, strength_,
+                          boundaries_[p]);
+  return {};
+}
+
+ConstBoundaryPlane Demultiplexer::boundaries(int projector) const {
+  return boundaries_[static_cast<std::size_t>(projector)];
+}
+
+ConstDirectionPlane Demultiplexer::directions(int projector) const {
+  return directions_[static_cast<std::size_t>(projector)];
+}
+
+std::span<const TileDirection> Demultiplexer::tileDirections(int projector) const {
+  return tileDirections_.subspan(static_cast<std::size_t>(projector) * layout_.tileCount(),
+                                 layout_.tileCount());
+}
+
+ImageView<const std::int16_t> Demultiplexer::separated(int channel) const {
+  return separated_[static_cast<std::size_t>(channel)];
+}
+
+}  // namespace smx::algo

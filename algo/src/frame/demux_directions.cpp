@@ -1,0 +1,268 @@
+// Stage 2: local stripe-encoding directions (paper §3.2).
+//   Per sample pixel: the colour structure tensor's doubled-angle vector
+//     a = Σ_c (gx² − gy²),  b = Σ_c 2·gx·gy   (g from central differences of S: 32 × grey/px)
+//   in int64; its angle (atan2, BinAngle) and weight √|(a, b)| (the gradient magnitude of a
+//   coherent edge; |(a, b)| by the octagonal norm, −2.8 % … +6.8 %; saturates at uint16).
+//   Per tile: a 64-bin histogram of the samples' doubled angles, weighted.
+//   Per tile window (windowTiles² tiles): lobes are maxima of π/2-wide angle windows stepped by
+//   π/4 that are not at a window edge; each is refined by two mean-shift steps (weighted mean of
+//   the samples' doubled angles within ±kRefineHalfWidth) and matched to the nearest predicted
+//   axis; the doubled angle is halved and its sign taken from the prediction.
+#include <cstdint>
+
+#include "demux_kernels.hpp"
+#include "smx/algo/fixed_math.hpp"
+
+namespace smx::algo::demux {
+
+namespace {
+
+constexpr int kRefineHalfWidth = 2 * kBinRaw;  // ±11.25° doubled, ±5.6° of orientation
+constexpr int kMaxLobes = 8;
+
+std::uint64_t abs64(std::int64_t v) {
+  return v < 0 ? static_cast<std::uint64_t>(-(v + 1)) + 1U : static_cast<std::uint64_t>(v);
+}
+
+// Octagonal approximation of |(a, b)|: max + 3/8·min.
+std::uint64_t approxNorm(std::int64_t a, std::int64_t b) {
+  std::uint64_t x = abs64(a);
+  std::uint64_t y = abs64(b);
+  if (x < y) {
+    const std::uint64_t t = x;
+    x = y;
+    y = t;
+  }
+  return x + (3 * y) / 8;
+}
+
+std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
+  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
+}
+
+struct Lobe {
+  std::uint16_t angle2 = 0;  // refined doubled angle
+  std::uint64_t weight = 0;  // sample weight within ±kRefineHalfWidth
+  bool used = false;
+};
+
+// Weighted mean of the window's samples within ±kRefineHalfWidth of centre (doubled angles).
+struct Window {
+  int sx0, sy0, sx1, sy1;  // sample index range [sx0, sx1) × [sy0, sy1)
+};
+
+Lobe refine(std::uint16_t centre, const Window& win, const SampleGrid& grid,
+            std::span<const std::uint16_t> angles, std::span<const std::uint16_t> weights) {
+  Lobe lobe;
+  lobe.angle2 = centre;
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    std::int64_t moment = 0;
+    std::uint64_t mass = 0;
+    for (int sy = win.sy0; sy < win.sy1; ++sy) {
+      const std::size_t row = static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
+      for (int sx = win.sx0; sx < win.sx1; ++sx) {
+        const std::size_t i = row + static_cast<std::size_t>(sx);
+        const std::uint16_t w = weights[i];
+        if (w == 0) {
+          continue;
+        }
+        const std::int32_t d = wrapDiff(angles[i], lobe.angle2);
+        if (d >= -kRefineHalfWidth && d <= kRefineHalfWidth) {
+          moment += static_cast<std::int64_t>(d) * w;
+          mass += w;
+        }
+      }
+    }
+    lobe.weight = mass;
+    if (mass == 0) {
+      break;
+    }
+    const auto shift = static_cast<std::int32_t>(moment / static_cast<std::int64_t>(mass));
+    lobe.angle2 = static_cast<std::uint16_t>(lobe.angle2 + static_cast<std::uint16_t>(shift));
+  }
+  return lobe;
+}
+
+}  // namespace
+
+SampleGrid sampleGrid(const DemuxLayout& layout) {
+  const int s = layout.params.histogramStride;
+  return {s, (layout.width + s - 1) / s, (layout.height + s - 1) / s};
+}
+
+void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
+                    std::span<std::uint16_t> sampleAngles, std::span<std::uint16_t> sampleWeights,
+                    std::span<std::uint32_t> tileHistograms) {
+  const SampleGrid grid = sampleGrid(layout);
+  const int w = layout.width;
+  const int h = layout.height;
+  const int t = layout.params.tilePx;
+  const int tilesX = layout.tilesX();
+  const std::int64_t minGrad = std::int64_t{layout.params.minGradientGrey} * 2 * kSmoothScale;
+  const auto minNorm = static_cast<std::uint64_t>(minGrad * minGrad);
+  for (auto& bin : tileHistograms) {
+    bin = 0;
+  }
+  for (int sy = 0; sy < grid.height; ++sy) {
+    const int y = sy * grid.stride;
+    const std::size_t sampleRow = static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
+    for (int sx = 0; sx < grid.width; ++sx) {
+      const int x = sx * grid.stride;
+      const std::size_t si = sampleRow + static_cast<std::size_t>(sx);
+      sampleWeights[si] = 0;
+      sampleAngles[si] = 0;
+      if (x < 1 || y < 1 || x + 1 >= w || y + 1 >= h) {
+        continue;
+      }
+      std::int64_t a = 0;
+      std::int64_t b = 0;
+      for (const auto& plane : smoothed) {
+        const std::int16_t* row = plane.rowPtr(y);
+        const std::int32_t gx = row[x + 1] - row[x - 1];
+        const std::int32_t gy = plane.rowPtr(y + 1)[x] - plane.rowPtr(y - 1)[x];
+        a += std::int64_t{gx} * gx - std::int64_t{gy} * gy;
+        b += 2 * std::int64_t{gx} * gy;
+      }
+      const std::uint64_t norm = approxNorm(a, b);
+      if (norm < minNorm) {
+        continue;
+      }
+      const std::uint64_t root = isqrt(norm);
+      const std::uint16_t weight = root > 65535U ? std::uint16_t{65535} : static_cast<std::uint16_t>(root);
+      const std::uint16_t angle = atan2(b, a).raw;
+      sampleWeights[si] = weight;
+      sampleAngles[si] = angle;
+      const std::size_t tile = static_cast<std::size_t>(y / t) * static_cast<std::size_t>(tilesX) +
+                               static_cast<std::size_t>(x / t);
+      const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
+      tileHistograms[tile * kBins + bin] += weight;
+    }
+  }
+}
+
+void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                        std::span<const std::uint16_t> sampleAngles,
+                        std::span<const std::uint16_t> sampleWeights,
+                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out) {
+  const SampleGrid grid = sampleGrid(layout);
+  const int tilesX = layout.tilesX();
+  const int tilesY = layout.tilesY();
+  const int t = layout.params.tilePx;
+  const int r = layout.params.windowTiles / 2;
+  const int projectors = layout.projectors;
+  const std::size_t tileCount = layout.tileCount();
+  const int tolerance2 = (layout.params.lobeToleranceDeg * 2 * 65536) / 360;
+  const auto minSharePct = static_cast<std::uint64_t>(layout.params.minLobeSharePct);
+
+  for (int ty = 0; ty < tilesY; ++ty) {
+    for (int tx = 0; tx < tilesX; ++tx) {
+      const std::size_t tile =
+          static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) + static_cast<std::size_t>(tx);
+      // The window histogram.
+      std::uint64_t hist[kBins] = {};
+      std::uint64_t total = 0;
+      for (int j = ty - r; j <= ty + r; ++j) {
+        for (int i = tx - r; i <= tx + r; ++i) {
+          if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
+            continue;
+          }
+          const std::uint32_t* src =
+              tileHistograms.data() +
+              (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) + static_cast<std::size_t>(i)) * kBins;
+          for (int k = 0; k < kBins; ++k) {
+            hist[k] += src[k];
+            total += src[k];
+          }
+        }
+      }
+      const auto clampSample = [](int v, int hi) { return v < 0 ? 0 : (v > hi ? hi : v); };
+      const Window win{
+          clampSample(((tx - r) * t + grid.stride - 1) / grid.stride, grid.width),
+          clampSample(((ty - r) * t + grid.stride - 1) / grid.stride, grid.height),
+          clampSample(((tx + r + 1) * t + grid.stride - 1) / grid.stride, grid.width),
+          clampSample(((ty + r + 1) * t + grid.stride - 1) / grid.stride, grid.height)};
+
+      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4).
+      Lobe lobes[kMaxLobes];
+      int lobeCount = 0;
+      int peakBins[kMaxLobes];
+      if (total > 0) {
+        for (int aw = 0; aw < 8; ++aw) {
+          const int start = aw * (kBins / 8);
+          int best = start;
+          for (int k = start; k < start + kBins / 4; ++k) {
+            if (hist[k % kBins] > hist[best % kBins]) {
+              best = k;
+            }
+          }
+          if (best == start || best == start + kBins / 4 - 1 || hist[best % kBins] == 0) {
+            continue;
+          }
+          const int bin = best % kBins;
+          bool seen = false;
+          for (int l = 0; l < lobeCount; ++l) {
+            seen = seen || peakBins[l] == bin;
+          }
+          if (seen) {
+            continue;
+          }
+          peakBins[lobeCount] = bin;
+          lobes[lobeCount] = refine(static_cast<std::uint16_t>(bin * kBinRaw), win, grid,
+                                    sampleAngles, sampleWeights);
+          ++lobeCount;
+        }
+      }
+
+      // Greedy matching: repeatedly the closest (projector, lobe) pair within tolerance.
+      bool assigned[kMaxProjectors] = {false, false, false};
+      for (int p = 0; p < projectors; ++p) {
+        TileDirection& d = out[static_cast<std::size_t>(p) * tileCount + tile];
+        d.angle = predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
+        d.present = 0;
+        d.sharePct = 0;
+      }
+      for (int round = 0; round < projectors; ++round) {
+        int bestP = -1;
+        int bestL = -1;
+        std::int32_t bestDiff = tolerance2 + 1;
+        for (int p = 0; p < projectors; ++p) {
+          if (assigned[p]) {
+            continue;
+          }
+          const std::uint16_t pred =
+              predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
+          const auto pred2 = static_cast<std::uint16_t>(pred << 1U);
+          for (int l = 0; l < lobeCount; ++l) {
+            if (lobes[l].used || lobes[l].weight * 100 < minSharePct * total) {
+              continue;
+            }
+            std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
+            diff = diff < 0 ? -diff : diff;
+            if (diff < bestDiff) {
+              bestDiff = diff;
+              bestP = p;
+              bestL = l;
+            }
+          }
+        }
+        if (bestP < 0) {
+          break;
+        }
+        assigned[bestP] = true;
+        lobes[bestL].used = true;
+        TileDirection& d = out[static_cast<std::size_t>(bestP) * tileCount + tile];
+        const std::uint16_t pred = d.angle;
+        auto angle = static_cast<std::uint16_t>(lobes[bestL].angle2 >> 1U);
+        const std::int32_t off = wrapDiff(angle, pred);
+        if (off > 16384 || off < -16384) {
+          angle = static_cast<std::uint16_t>(angle + 32768U);
+        }
+        d.angle = angle;
+        d.present = 1;
+        d.sharePct = static_cast<std::uint8_t>((lobes[bestL].weight * 100) / total);
+      }
+    }
+  }
+}
+
+}  // namespace smx::algo::demux

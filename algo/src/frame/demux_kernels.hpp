@@ -1,0 +1,99 @@
+#pragma once
+
+// The per-frame stages of orientation demultiplexing (demux.hpp), one file each. Integer only,
+// no allocation: every buffer is passed in, carved from the arena at create().
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "smx/algo/boundary_map.hpp"
+#include "smx/algo/demux.hpp"
+#include "smx/algo/image_view.hpp"
+
+namespace smx::algo::demux {
+
+inline constexpr int kBins = 64;                  // doubled-angle histogram bins (2π)
+inline constexpr int kBinRaw = 65536 / kBins;     // BinAngle raw units per bin
+inline constexpr int kUnitShift = 14;             // unit vectors are Q1.14
+inline constexpr int kUnit = 1 << kUnitShift;
+inline constexpr int kRelativeShift = 11;         // separated values: Q4.11 of the local average
+inline constexpr int kInverseShift = 24;          // tile inverse colour: 2^24 / average
+inline constexpr int kSmoothScale = 16;           // smoothed planes hold 16 × grey level
+inline constexpr int kColourFloor = 8 * kSmoothScale;  // averages below 8 grey levels clamp
+
+// A unit vector (Q1.14) from a BinAngle by a 1024-entry table (nearest entry: <= 0.18°).
+class UnitTable {
+ public:
+  static constexpr int kEntries = 1024;
+  void fill();
+  [[nodiscard]] std::int32_t cosOf(std::uint16_t angle) const {
+    return cos_[static_cast<std::size_t>(((angle + 32U) >> 6U) & (kEntries - 1U))];
+  }
+  [[nodiscard]] std::int32_t sinOf(std::uint16_t angle) const {
+    return cosOf(static_cast<std::uint16_t>(angle - 16384U));
+  }
+
+ private:
+  std::array<std::int16_t, kEntries> cos_{};
+};
+
+using Planes3 = std::array<ImageView<std::int16_t>, 3>;
+
+// Stage 1: S_c = [1 2 1]ᵀ[1 2 1] * I_c (edges repeated), i.e. 16 × the binomially smoothed
+// grey level (0…4080); without smoothing 16 × I_c. rowScratch holds 2 × width values.
+void smoothChannels(ConstRgbView image, const Planes3& out, bool smooth,
+                    std::span<std::int16_t> rowScratch);
+
+// Per tile and channel, Σ S over the tile's pixels.
+void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t> sums);
+
+// 2^24 / max(window average, floor) per tile and channel, the window being windowTiles² tiles.
+void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& layout,
+                        bool normalise, std::span<std::uint32_t> inverse);
+
+// Stage 2a: the doubled gradient angle and weight of every histogram sample, and each tile's
+// histogram of them.
+struct SampleGrid {
+  int stride = 2;
+  int width = 0;   // samples per row
+  int height = 0;  // sample rows
+};
+[[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
+void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
+                    std::span<std::uint16_t> sampleAngles, std::span<std::uint16_t> sampleWeights,
+                    std::span<std::uint32_t> tileHistograms);
+
+// Stage 2b: lobes of each tile's window histogram matched to the predicted directions.
+// out[p * tileCount + t].
+void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                        std::span<const std::uint16_t> sampleAngles,
+                        std::span<const std::uint16_t> sampleWeights,
+                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out);
+
+// Bilinear interpolation between tile centres (tile i's centre is pixel i·T + (T−1)/2), per
+// column or row: the lower tile, the upper one, the upper one's weight in 1/256 and the
+// nearest tile.
+struct TileInterp {
+  std::int16_t lower;
+  std::int16_t upper;
+  std::int16_t weight;
+  std::int16_t nearest;
+};
+void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
+
+// Stages 3–4 for one projector: separated, colour-normalised derivative per channel (Q4.11),
+// the derivative order per pixel (1 or 2; 0 on the border) and the projector's direction plane.
+void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
+              std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
+              std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+              const UnitTable& units, const Planes3& separated, ImageView<std::uint8_t> order,
+              DirectionPlane direction);
+
+// Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
+// suppression along the encoding direction, sub-pixel offset and class.
+void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
+                      ConstDirectionPlane direction, const UnitTable& units, int minStrength,
+                      ImageView<std::uint16_t> strength, BoundaryPlane out);
+
+}  // namespace smx::algo::demux

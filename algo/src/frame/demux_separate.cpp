@@ -1,0 +1,157 @@
+// Stages 3–4: pattern separation by steered derivatives (paper eqs 6–10) and division by the
+// locally averaged colour (§4.3).
+//   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
+//   to the pixel; unit vectors Q1.14 from the table. Presence: the nearest tile's.
+//   First order  D_c = v · (gx, gy)_c, gx = S(x+1) − S(x−1): 32 × grey/px; v = the projector's
+//                own axis (no other pattern present) or the normal of the other pattern's axis,
+//                signed towards this projector's axis (so the surviving term keeps its sign).
+//   Second order D_c = ½ · vᵀ H_c w with H = 4 × (Sxx, Sxy; Sxy, Syy) from 3×3 differences;
+//                v, w the normals of the two other patterns' axes, signed likewise.
+//   Products of Q1.14 coefficients in int64, one shift each. Normalised value
+//   N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour, saturated to
+//   int16.
+#include <cstdint>
+
+#include "demux_kernels.hpp"
+
+namespace smx::algo::demux {
+
+namespace {
+
+std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
+  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
+}
+
+std::int16_t saturate16(std::int64_t v) {
+  return static_cast<std::int16_t>(v > 32767 ? 32767 : (v < -32768 ? -32768 : v));
+}
+
+struct Vec {
+  std::int32_t x;
+  std::int32_t y;
+};
+
+// The normal of axis, turned so that its dot product with towards is non-negative.
+Vec normalTowards(Vec axis, Vec towards) {
+  Vec n{-axis.y, axis.x};
+  const std::int64_t dot = std::int64_t{n.x} * towards.x + std::int64_t{n.y} * towards.y;
+  if (dot < 0) {
+    n = {-n.x, -n.y};
+  }
+  return n;
+}
+
+}  // namespace
+
+void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out) {
+  const int span2 = 2 * tilePx;
+  for (int x = 0; x < pixels; ++x) {
+    const int u2 = 2 * x - (tilePx - 1);  // twice the distance from tile 0's centre
+    TileInterp ti{};
+    if (u2 <= 0) {
+      ti = {0, 0, 0, 0};
+    } else {
+      const int lower = u2 / span2;
+      if (lower >= tiles - 1) {
+        ti.lower = ti.upper = static_cast<std::int16_t>(tiles - 1);
+        ti.weight = 0;
+      } else {
+        ti.lower = static_cast<std::int16_t>(lower);
+        ti.upper = static_cast<std::int16_t>(lower + 1);
+        ti.weight = static_cast<std::int16_t>(((u2 - lower * span2) * 256) / span2);
+      }
+    }
+    ti.nearest = static_cast<std::int16_t>(x / tilePx < tiles ? x / tilePx : tiles - 1);
+    out[static_cast<std::size_t>(x)] = ti;
+  }
+}
+
+void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
+              std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
+              std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+              const UnitTable& units, const Planes3& separated, ImageView<std::uint8_t> order,
+              DirectionPlane direction) {
+  const int w = layout.width;
+  const int h = layout.height;
+  const int projectors = layout.projectors;
+  const int tilesX = layout.tilesX();
+  const std::size_t tileCount = layout.tileCount();
+  const auto tileAt = [&](int p, int tx, int ty) -> const TileDirection& {
+    return tiles[static_cast<std::size_t>(p) * tileCount +
+                 static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                 static_cast<std::size_t>(tx)];
+  };
+  constexpr int kNormShift = kInverseShift - kRelativeShift;
+
+  for (int y = 0; y < h; ++y) {
+    std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y),
+                            separated[2].rowPtr(y)};
+    std::uint8_t* orderRow = order.rowPtr(y);
+    std::uint16_t* dirRow = direction.rowPtr(y);
+    const TileInterp& ry = rows[static_cast<std::size_t>(y)];
+    const bool borderRow = y == 0 || y + 1 == h;
+    for (int x = 0; x < w; ++x) {
+      const TileInterp& cx = columns[static_cast<std::size_t>(x)];
+      // Directions of every projector at this pixel.
+      std::uint16_t angle[kMaxProjectors] = {0, 0, 0};
+      bool present[kMaxProjectors] = {false, false, false};
+      for (int p = 0; p < projectors; ++p) {
+        const std::uint16_t a00 = tileAt(p, cx.lower, ry.lower).angle;
+        const std::int64_t d10 = wrapDiff(tileAt(p, cx.upper, ry.lower).angle, a00);
+        const std::int64_t d01 = wrapDiff(tileAt(p, cx.lower, ry.upper).angle, a00);
+        const std::int64_t d11 = wrapDiff(tileAt(p, cx.upper, ry.upper).angle, a00);
+        const std::int64_t wx = cx.weight;
+        const std::int64_t wy = ry.weight;
+        const std::int64_t delta =
+            (d10 * wx * (256 - wy) + d01 * (256 - wx) * wy + d11 * wx * wy + 32768) >> 16;
+        angle[p] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
+        present[p] = tileAt(p, cx.nearest, ry.nearest).present != 0;
+      }
+      dirRow[x] = angle[projector];
+      if (borderRow || x == 0 || x + 1 == w) {
+        out[0][x] = out[1][x] = out[2][x] = 0;
+        orderRow[x] = 0;
+        continue;
+      }
+      const Vec own{units.cosOf(angle[projector]), units.sinOf(angle[projector])};
+      Vec others[2] = {{0, 0}, {0, 0}};
+      int otherCount = 0;
+      for (int q = 0; q < projectors; ++q) {
+        if (q != projector && present[q]) {
+          others[otherCount++] = normalTowards({units.cosOf(angle[q]), units.sinOf(angle[q])}, own);
+        }
+      }
+      const std::size_t colourTile =
+          (static_cast<std::size_t>(ry.nearest) * static_cast<std::size_t>(tilesX) +
+           static_cast<std::size_t>(cx.nearest)) *
+          3;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const ImageView<std::int16_t>& s = smoothed[c];
+        const std::int16_t* up = s.rowPtr(y - 1);
+        const std::int16_t* mid = s.rowPtr(y);
+        const std::int16_t* down = s.rowPtr(y + 1);
+        std::int64_t d = 0;
+        if (otherCount < 2) {
+          const Vec v = otherCount == 0 ? own : others[0];
+          const std::int64_t gx = mid[x + 1] - mid[x - 1];
+          const std::int64_t gy = down[x] - up[x];
+          d = (v.x * gx + v.y * gy) >> kUnitShift;
+        } else {
+          const std::int64_t hxx = 4 * (mid[x + 1] - 2 * mid[x] + mid[x - 1]);
+          const std::int64_t hyy = 4 * (down[x] - 2 * mid[x] + up[x]);
+          const std::int64_t hxy = down[x + 1] - down[x - 1] - up[x + 1] + up[x - 1];
+          const Vec& v = others[0];
+          const Vec& u = others[1];
+          const std::int64_t cxx = std::int64_t{v.x} * u.x;
+          const std::int64_t cyy = std::int64_t{v.y} * u.y;
+          const std::int64_t cxy = std::int64_t{v.x} * u.y + std::int64_t{v.y} * u.x;
+          d = (cxx * hxx + cxy * hxy + cyy * hyy) >> (2 * kUnitShift + 1);
+        }
+        out[c][x] = saturate16((d * inverseColour[colourTile + c]) >> kNormShift);
+      }
+      orderRow[x] = otherCount < 2 ? 1 : 2;
+    }
+  }
+}
+
+}  // namespace smx::algo::demux

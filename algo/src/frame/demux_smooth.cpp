@@ -1,0 +1,160 @@
+// Stage 1 and the colour averages of stage 4.
+//   Input   8-bit RGB.
+//   Output  int16 planes, 16 × smoothed grey (0…4080): the [1 2 1] kernel sums to 4 per pass.
+//   Accumulators int32 (tile sums uint32: a 64×64 tile of 4080 is < 2^24). Nothing saturates.
+#include <cstdint>
+
+#include "demux_kernels.hpp"
+
+namespace smx::algo::demux {
+
+namespace {
+
+// Horizontal pass of one channel of one row into dst (values 0…1020).
+template <int Channel>
+void horizontal(const Rgb8* src, int width, std::int16_t* dst) {
+  const auto at = [src](int x) {
+    const std::uint8_t* p = &src[x].r;
+    return static_cast<int>(p[Channel]);
+  };
+  if (width == 1) {
+    dst[0] = static_cast<std::int16_t>(4 * at(0));
+    return;
+  }
+  dst[0] = static_cast<std::int16_t>(3 * at(0) + at(1));
+  for (int x = 1; x + 1 < width; ++x) {
+    dst[x] = static_cast<std::int16_t>(at(x - 1) + 2 * at(x) + at(x + 1));
+  }
+  dst[width - 1] = static_cast<std::int16_t>(at(width - 2) + 3 * at(width - 1));
+}
+
+template <int Channel>
+void smoothChannel(ConstRgbView image, ImageView<std::int16_t> out, std::int16_t* prev,
+                   std::int16_t* cur) {
+  const int w = image.width();
+  const int h = image.height();
+  for (int y = 0; y < h; ++y) {
+    horizontal<Channel>(image.rowPtr(y), w, out.rowPtr(y));
+  }
+  // Vertical pass in place: row y needs the horizontal rows y−1 (kept in prev), y and y+1.
+  const std::int16_t* first = out.rowPtr(0);
+  for (int x = 0; x < w; ++x) {
+    prev[x] = first[x];
+  }
+  for (int y = 0; y < h; ++y) {
+    std::int16_t* row = out.rowPtr(y);
+    const std::int16_t* next = y + 1 < h ? out.rowPtr(y + 1) : row;
+    for (int x = 0; x < w; ++x) {
+      cur[x] = row[x];
+    }
+    for (int x = 0; x < w; ++x) {
+      row[x] = static_cast<std::int16_t>(prev[x] + 2 * cur[x] + next[x]);
+    }
+    std::int16_t* t = prev;
+    prev = cur;
+    cur = t;
+  }
+}
+
+template <int Channel>
+void copyChannel(ConstRgbView image, ImageView<std::int16_t> out) {
+  for (int y = 0; y < image.height(); ++y) {
+    const Rgb8* src = image.rowPtr(y);
+    std::int16_t* dst = out.rowPtr(y);
+    for (int x = 0; x < image.width(); ++x) {
+      const std::uint8_t* p = &src[x].r;
+      dst[x] = static_cast<std::int16_t>(kSmoothScale * p[Channel]);
+    }
+  }
+}
+
+}  // namespace
+
+void smoothChannels(ConstRgbView image, const Planes3& out, bool smooth,
+                    std::span<std::int16_t> rowScratch) {
+  if (!smooth) {
+    copyChannel<0>(image, out[0]);
+    copyChannel<1>(image, out[1]);
+    copyChannel<2>(image, out[2]);
+    return;
+  }
+  const auto w = static_cast<std::size_t>(image.width());
+  std::int16_t* a = rowScratch.data();
+  std::int16_t* b = a + w;
+  smoothChannel<0>(image, out[0], a, b);
+  smoothChannel<1>(image, out[1], a, b);
+  smoothChannel<2>(image, out[2], a, b);
+}
+
+void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t> sums) {
+  const int w = smoothed[0].width();
+  const int h = smoothed[0].height();
+  const int tilesX = (w + tilePx - 1) / tilePx;
+  for (auto& s : sums) {
+    s = 0;
+  }
+  for (int c = 0; c < 3; ++c) {
+    for (int y = 0; y < h; ++y) {
+      const std::int16_t* row = smoothed[static_cast<std::size_t>(c)].rowPtr(y);
+      std::uint32_t* tileRow =
+          sums.data() + static_cast<std::size_t>(y / tilePx) * static_cast<std::size_t>(tilesX) * 3;
+      for (int tx = 0; tx < tilesX; ++tx) {
+        const int x1 = tx * tilePx + tilePx < w ? tx * tilePx + tilePx : w;
+        std::uint32_t acc = 0;
+        for (int x = tx * tilePx; x < x1; ++x) {
+          acc += static_cast<std::uint32_t>(row[x]);
+        }
+        tileRow[static_cast<std::size_t>(tx) * 3 + static_cast<std::size_t>(c)] += acc;
+      }
+    }
+  }
+}
+
+void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& layout,
+                        bool normalise, std::span<std::uint32_t> inverse) {
+  const int tilesX = layout.tilesX();
+  const int tilesY = layout.tilesY();
+  const int r = layout.params.windowTiles / 2;
+  const int t = layout.params.tilePx;
+  for (int ty = 0; ty < tilesY; ++ty) {
+    for (int tx = 0; tx < tilesX; ++tx) {
+      const auto out = (static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                        static_cast<std::size_t>(tx)) *
+                       3;
+      if (!normalise) {
+        // A fixed mid-grey average: values stay proportional to the raw derivative.
+        for (std::size_t c = 0; c < 3; ++c) {
+          inverse[out + c] = (1U << kInverseShift) / (128U * kSmoothScale);
+        }
+        continue;
+      }
+      std::uint64_t acc[3] = {0, 0, 0};
+      std::uint64_t pixels = 0;
+      for (int j = ty - r; j <= ty + r; ++j) {
+        for (int i = tx - r; i <= tx + r; ++i) {
+          if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
+            continue;
+          }
+          const auto in = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
+                           static_cast<std::size_t>(i)) *
+                          3;
+          for (std::size_t c = 0; c < 3; ++c) {
+            acc[c] += sums[in + c];
+          }
+          const int tw = (i + 1) * t <= layout.width ? t : layout.width - i * t;
+          const int th = (j + 1) * t <= layout.height ? t : layout.height - j * t;
+          pixels += static_cast<std::uint64_t>(tw) * static_cast<std::uint64_t>(th);
+        }
+      }
+      for (std::size_t c = 0; c < 3; ++c) {
+        std::uint64_t average = pixels > 0 ? acc[c] / pixels : 0;
+        if (average < kColourFloor) {
+          average = kColourFloor;
+        }
+        inverse[out + c] = static_cast<std::uint32_t>((std::uint64_t{1} << kInverseShift) / average);
+      }
+    }
+  }
+}
+
+}  // namespace smx::algo::demux

@@ -1,0 +1,65 @@
+#include "sim_frame.hpp"
+
+#include <stdexcept>
+
+#include "smx/protocol/rig_json.hpp"
+#include "smx/sim/renderer.hpp"
+#include "smx/sim/scene_json.hpp"
+
+namespace smx::test {
+
+namespace {
+const std::filesystem::path kSource = SMX_SOURCE_DIR;
+}  // namespace
+
+algo::Rig loadExampleRig(const std::string& file) {
+  auto rig = protocol::loadRig(kSource / "boards/sim" / file);
+  if (!rig) {
+    throw std::runtime_error(rig.error().message());
+  }
+  return *rig;
+}
+
+sim::Scene loadNamedScene(const std::string& name) {
+  auto scene = sim::loadScene(kSource / "hal/sim/scenes" / (name + ".json"));
+  if (!scene) {
+    throw std::runtime_error(scene.error().message());
+  }
+  return *scene;
+}
+
+SimFrame renderSimFrame(const SimRequest& request) {
+  return renderSimFrame(request, loadNamedScene(request.scene));
+}
+
+SimFrame renderSimFrame(const SimRequest& request, const sim::Scene& scene) {
+  SimFrame f;
+  f.rig = loadExampleRig(request.rigFile);
+  const auto& cam = f.rig.cameras.at(static_cast<std::size_t>(request.camera));
+  const int w = cam.width;
+  const int h = cam.height;
+  const std::size_t projectors = f.rig.projectors.size();
+  f.image = OwnedPlane<algo::Rgb8>(w, h, algo::Rgb8{0, 0, 0});
+  f.depth = OwnedPlane<float>(w, h, 0.0F);
+  sim::GroundTruthViews truth;
+  truth.depth = f.depth.view();
+  for (std::size_t p = 0; p < projectors; ++p) {
+    f.lit.emplace_back(w, h, std::uint8_t{0});
+    f.stripe.emplace_back(w, h, 0.0F);
+  }
+  for (std::size_t p = 0; p < projectors; ++p) {
+    truth.projectors.push_back({f.lit[p].view(), {}, {}, f.stripe[p].view()});
+  }
+  auto renderer = sim::Renderer::create(f.rig, scene);
+  if (!renderer) {
+    throw std::runtime_error(renderer.error());
+  }
+  const sim::FrameRequest frame{request.camera, request.frame, std::vector<bool>(projectors, true),
+                                request.seed};
+  if (auto ok = (*renderer)->render(frame, f.image.view(), &truth); !ok) {
+    throw std::runtime_error(ok.error());
+  }
+  return f;
+}
+
+}  // namespace smx::test
