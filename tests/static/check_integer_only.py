@@ -2,7 +2,8 @@
 """Proves per-frame object files are integer-only and heap-free by reading their aarch64 code.
 
 Fails on:
-  fp        floating-point instructions (A64 mnemonics starting with 'f', scvtf/ucvtf, bf*),
+  fp        floating-point instructions (A64 mnemonics starting with 'f', scvtf/ucvtf, BFloat16
+            bf* but not the integer bitfield moves bfi/bfm/bfxil/bfc),
             except fmov between a general register and an FP/SIMD register (a bit move that
             integer NEON code uses);
   softfloat calls to compiler soft-float helpers (long double on aarch64 is software quad);
@@ -19,7 +20,9 @@ import re
 import subprocess
 import sys
 
+# bf* are the BFloat16 instructions, except the integer bitfield moves bfi, bfm, bfxil, bfc.
 FP_MNEMONIC = re.compile(r"^(f[a-z0-9]*|scvtf|ucvtf|bf[a-z0-9]*)(\.|$)")
+INTEGER_BF = {"bfi", "bfm", "bfxil", "bfc"}
 GPR = re.compile(r"^(x|w)([0-9]+|zr)$")
 SOFTFLOAT = re.compile(r"^__[a-z]*(sf|df|tf|xf|hf|bf)[a-z]*[0-9]*$")
 LIBM = re.compile(
@@ -69,7 +72,8 @@ def scan(objdump, obj):
         if not m:
             continue
         mnemonic, operands = m.group(1), m.group(2)
-        if FP_MNEMONIC.match(mnemonic) and not (mnemonic == "fmov" and is_gpr_fmov(operands)):
+        if (FP_MNEMONIC.match(mnemonic) and mnemonic not in INTEGER_BF
+                and not (mnemonic == "fmov" and is_gpr_fmov(operands))):
             yield func, "fp", (mnemonic + " " + operands).strip()
 
 

@@ -1,6 +1,7 @@
 #include "sim_frame.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/renderer.hpp"
@@ -9,11 +10,13 @@
 namespace smx::test {
 
 namespace {
-const std::filesystem::path kSource = SMX_SOURCE_DIR;
+std::filesystem::path sourceDir() {
+  return SMX_SOURCE_DIR;
+}
 }  // namespace
 
 algo::Rig loadExampleRig(const std::string& file) {
-  auto rig = protocol::loadRig(kSource / "boards/sim" / file);
+  auto rig = protocol::loadRig(sourceDir() / "boards/sim" / file);
   if (!rig) {
     throw std::runtime_error(rig.error().message());
   }
@@ -21,7 +24,7 @@ algo::Rig loadExampleRig(const std::string& file) {
 }
 
 sim::Scene loadNamedScene(const std::string& name) {
-  auto scene = sim::loadScene(kSource / "hal/sim/scenes" / (name + ".json"));
+  auto scene = sim::loadScene(sourceDir() / "hal/sim/scenes" / (name + ".json"));
   if (!scene) {
     throw std::runtime_error(scene.error().message());
   }
@@ -33,8 +36,12 @@ SimFrame renderSimFrame(const SimRequest& request) {
 }
 
 SimFrame renderSimFrame(const SimRequest& request, const sim::Scene& scene) {
+  return renderSimFrame(loadExampleRig(request.rigFile), scene, request);
+}
+
+SimFrame renderSimFrame(algo::Rig rig, const sim::Scene& scene, const SimRequest& request) {
   SimFrame f;
-  f.rig = loadExampleRig(request.rigFile);
+  f.rig = std::move(rig);
   const auto& cam = f.rig.cameras.at(static_cast<std::size_t>(request.camera));
   const int w = cam.width;
   const int h = cam.height;

@@ -51,6 +51,8 @@ struct SimRequest {
 };
 [[nodiscard]] SimFrame renderSimFrame(const SimRequest& request);
 [[nodiscard]] SimFrame renderSimFrame(const SimRequest& request, const sim::Scene& scene);
+[[nodiscard]] SimFrame renderSimFrame(algo::Rig rig, const sim::Scene& scene,
+                                      const SimRequest& request = {});
 [[nodiscard]] sim::Scene loadNamedScene(const std::string& name);
 [[nodiscard]] algo::Rig loadExampleRig(const std::string& file);
 

@@ -1,8 +1,18 @@
-// Orientation demultiplexing against simulator ground truth (fixed seeds, the paper's noise):
-// encoding directions, boundary recall / precision / class / sub-pixel position.
+// Orientation demultiplexing against the simulator's ground truth (fixed seed, the paper's
+// noise): encoding directions, boundary recall / precision / class and sub-pixel position, per
+// projector, in the regions lit by exactly 1, 2 or 3 patterns (away from occlusion edges).
+// Each case prints its figures (`demux_accuracy_test` alone prints the table quoted in notes).
+//
+// Targets (issue): directions median ≤ 2°, 95th percentile ≤ 5°; boundaries recall and precision
+// ≥ 98 % (2 patterns) / ≥ 95 % (3), class ≥ 99 % (2 patterns) / ≥ 97 % (RGBCMY panel), position
+// RMS ≤ 0.15 px. Where a target is not met yet the test asserts the measured level (a ratchet)
+// and says so.
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "boundary_eval.hpp"
@@ -13,66 +23,145 @@
 namespace smx::algo {
 namespace {
 
-struct DemuxRun {
+// Predictions are made for a surface at 0.75 m while the scenes stand at 0.9 m and beyond, so
+// the measured directions are the estimator's, not the calibration's.
+constexpr double kNominalDepthM = 0.75;
+
+struct Demuxed {
   std::vector<std::byte> memory;
   std::optional<Arena> arena;
   std::optional<Demultiplexer> demux;
 };
 
-std::unique_ptr<DemuxRun> runDemux(const test::SimFrame& f, const DemuxParams& params = {}) {
-  auto run = std::make_unique<DemuxRun>();
-  DemuxLayout layout{f.image.width, f.image.height, static_cast<int>(f.rig.projectors.size()),
-                     params};
+std::unique_ptr<Demuxed> runDemux(const test::SimFrame& f) {
+  auto out = std::make_unique<Demuxed>();
+  const DemuxLayout layout{
+      f.image.width, f.image.height, static_cast<int>(f.rig.projectors.size()), {}};
   const auto bytes = Demultiplexer::workspaceBytes(layout);
   EXPECT_TRUE(bytes.has_value());
-  run->memory.resize(*bytes);
-  run->arena.emplace(run->memory);
-  const auto predicted = predictEncodingAngles(f.rig, 0, layout, 0.9);
+  out->memory.resize(bytes.value_or(0));
+  out->arena.emplace(out->memory);
+  const auto predicted = predictEncodingAngles(f.rig, 0, layout, kNominalDepthM);
   EXPECT_TRUE(predicted.has_value()) << predicted.error();
-  auto d = Demultiplexer::create(layout, *predicted, *run->arena);
-  EXPECT_TRUE(d.has_value()) << d.error().message;
-  run->demux.emplace(std::move(*d));
-  const auto ok = run->demux->run(f.image.view());
-  EXPECT_TRUE(ok.has_value());
-  return run;
+  auto demux = Demultiplexer::create(layout, predicted.value(), *out->arena);
+  EXPECT_TRUE(demux.has_value()) << demux.error().message;
+  out->demux.emplace(std::move(*demux));
+  EXPECT_TRUE(out->demux->run(f.image.view()).has_value());
+  return out;
 }
 
-void report(const char* name, const test::SimFrame& f, const Demultiplexer& d) {
+struct Figures {
+  test::BoundaryScore boundaries;
+  test::AngleStats directions;
+};
+
+// Projector p's figures where exactly `patterns` projectors light the surface, p among them,
+// 3 px inside that region and away from depth jumps over 2 %.
+Figures measure(const test::SimFrame& f, const Demultiplexer& d, int p, int patterns,
+                const std::string& label) {
   std::vector<ImageView<const std::uint8_t>> lits;
-  for (const auto& l : f.lit) {
-    lits.push_back(l.view());
+  for (const auto& lit : f.lit) {
+    lits.push_back(lit.view());
   }
-  for (int n = 1; n <= static_cast<int>(lits.size()); ++n) {
-    const auto region =
-        test::smoothOnly(test::erode(test::litByExactly(lits, n), 3), f.depth.view(), 0.02);
-    for (std::size_t p = 0; p < lits.size(); ++p) {
-      test::Mask mine = region;
-      for (int y = 0; y < mine.height; ++y) {
-        for (int x = 0; x < mine.width; ++x) {
-          mine.at(x, y) = (mine.at(x, y) != 0 && lits[p](x, y) != 0) ? 255 : 0;
-        }
-      }
-      if (mine.count() < 100) continue;
-      const auto s = test::scoreBoundaries(d.boundaries(static_cast<int>(p)),
-                                           d.directions(static_cast<int>(p)), f.stripe[p].view(),
-                                           mine.view());
-      const auto a = test::scoreDirections(d.directions(static_cast<int>(p)), f.stripe[p].view(),
-                                           mine.view());
-      std::printf("%s lit-by-%d proj%zu px=%d dir med %.2f p95 %.2f | true %d det %d recall %.4f "
-                  "precision %.4f class %.4f rms %.3f bias %.3f\n",
-                  name, n, p, mine.count(), a.medianDeg, a.p95Deg, s.trueBoundaries, s.detected,
-                  s.recall, s.precision, s.classAccuracy, s.positionRmsPx, s.positionMeanPx);
+  test::Mask region =
+      test::smoothOnly(test::erode(test::litByExactly(lits, patterns), 3), f.depth.view(), 0.02);
+  const auto& mine = f.lit[static_cast<std::size_t>(p)];
+  for (int y = 0; y < region.height; ++y) {
+    for (int x = 0; x < region.width; ++x) {
+      region.at(x, y) = (region.at(x, y) != 0 && mine.at(x, y) != 0) ? 255 : 0;
     }
   }
+  Figures fig{test::scoreBoundaries(d.boundaries(p), d.directions(p),
+                                    f.stripe[static_cast<std::size_t>(p)].view(), region.view()),
+              test::scoreDirections(d.directions(p), f.stripe[static_cast<std::size_t>(p)].view(),
+                                    region.view())};
+  const auto& b = fig.boundaries;
+  std::printf(
+      "%-22s proj%d lit by %d: %6d px | direction median %.2f p95 %.2f deg | boundaries %6d "
+      "recall %.4f precision %.4f class %.4f position rms %.3f px\n",
+      label.c_str(), p, patterns, region.count(), fig.directions.medianDeg, fig.directions.p95Deg,
+      b.trueBoundaries, b.recall, b.precision, b.classAccuracy, b.positionRmsPx);
+  return fig;
 }
 
-TEST(DemuxAccuracy, Explore) {
-  for (const auto& [rigFile, scene] : std::vector<std::pair<std::string, std::string>>{
-           {"rig_2proj_1cam.json", "plane"}, {"rig_2proj_1cam.json", "sphere"},
-           {"rig_3proj_1cam.json", "plane"}, {"rig_2proj_1cam.json", "rgbcmy_panel"}}) {
-    const auto f = test::renderSimFrame({rigFile, scene});
-    const auto run = runDemux(f);
-    report((rigFile + "/" + scene).c_str(), f, *run->demux);
+struct Limits {
+  double directionMedianDeg;
+  double directionP95Deg;
+  double recall;
+  double precision;
+  double classAccuracy;
+  double positionRmsPx;
+};
+
+void expectWithin(const Figures& fig, const Limits& l, const std::string& what) {
+  EXPECT_GT(fig.boundaries.trueBoundaries, 1000) << what;
+  EXPECT_LE(fig.directions.medianDeg, l.directionMedianDeg) << what;
+  EXPECT_LE(fig.directions.p95Deg, l.directionP95Deg) << what;
+  EXPECT_GE(fig.boundaries.recall, l.recall) << what;
+  EXPECT_GE(fig.boundaries.precision, l.precision) << what;
+  EXPECT_GE(fig.boundaries.classAccuracy, l.classAccuracy) << what;
+  EXPECT_LE(fig.boundaries.positionRmsPx, l.positionRmsPx) << what;
+  EXPECT_EQ(fig.boundaries.wrongDirectionSign, 0) << what;
+}
+
+constexpr Limits kTwoPatternTargets{2.0, 5.0, 0.98, 0.98, 0.99, 0.15};
+
+// Given the flat board and two patterns 90° apart, every target holds for both projectors.
+TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
+  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
+  const auto d = runDemux(f);
+  for (int p = 0; p < 2; ++p) {
+    expectWithin(measure(f, *d->demux, p, 2, "plane 90deg"), kTwoPatternTargets,
+                 "projector " + std::to_string(p));
+  }
+}
+
+// The same with the second pattern turned to 70° from the first.
+TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
+  auto rig = test::loadExampleRig("rig_2proj_1cam.json");
+  rig.projectors[1].pattern.angleDeg = 70.0;
+  const auto f = test::renderSimFrame(rig, test::loadNamedScene("plane"));
+  const auto d = runDemux(f);
+  for (int p = 0; p < 2; ++p) {
+    expectWithin(measure(f, *d->demux, p, 2, "plane 70deg"), kTwoPatternTargets,
+                 "projector " + std::to_string(p));
+  }
+}
+
+// A sphere before a wall: curved surface, shadows, an occluding contour. Directions near the
+// contour are estimated from windows that straddle sphere and wall, so the 95th percentile is
+// far off target (ratchet: 25°); boundaries are within a point of the targets (ratchet).
+TEST(DemuxAccuracy, TwoPatternsOnASphere) {
+  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
+  const auto d = runDemux(f);
+  for (int p = 0; p < 2; ++p) {
+    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"), {1.0, 25.0, 0.975, 0.98, 0.985, 0.16},
+                 "projector " + std::to_string(p));
+    expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.16},
+                 "projector " + std::to_string(p) + " alone");
+  }
+}
+
+// Three patterns 60° apart on the board: recall, precision and class meet the targets; the
+// direction spread and the position error do not yet (ratchets: p95 10°, RMS 0.25 px).
+TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
+  const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
+  const auto d = runDemux(f);
+  for (int p = 0; p < 3; ++p) {
+    expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"),
+                 {2.0, 10.0, 0.95, 0.95, 0.97, 0.25}, "projector " + std::to_string(p));
+  }
+}
+
+// The RGBCMY panel (paper Fig. 13): strong surface colours, divided out by the local average.
+// Class accuracy meets the panel's 97 % target; the position error at colour edges does not
+// (ratchet 0.21 px).
+TEST(DemuxAccuracy, TwoPatternsOnTheRgbcmyPanel) {
+  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
+  const auto d = runDemux(f);
+  for (int p = 0; p < 2; ++p) {
+    expectWithin(measure(f, *d->demux, p, 2, "rgbcmy panel 90deg"),
+                 {2.0, 5.0, 0.98, 0.98, 0.97, 0.21}, "projector " + std::to_string(p));
   }
 }
 

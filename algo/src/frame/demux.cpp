@@ -30,9 +30,11 @@ Result<void> validate(const DemuxLayout& l) {
     return fail(Errc::kInvalidArgument, "demux: 1 to 3 projectors");
   }
   if (p.tilePx < 4 || p.tilePx > 64 || p.windowTiles < 1 || p.windowTiles > 9 ||
-      p.windowTiles % 2 == 0 || p.histogramStride < 1 || p.histogramStride > 8) {
+      p.windowTiles % 2 == 0 || p.histogramStride < 1 || p.histogramStride > 8 ||
+      p.smoothPasses < 0 || p.smoothPasses > 3) {
     return fail(Errc::kInvalidArgument,
-                "demux: tilePx 4 to 64, windowTiles odd 1 to 9, histogramStride 1 to 8");
+                "demux: tilePx 4 to 64, windowTiles odd 1 to 9, histogramStride 1 to 8, "
+                "smoothPasses 0 to 3");
   }
   if (p.lobeToleranceDeg < 1 || p.lobeToleranceDeg > 45 || p.minLobeSharePct < 0 ||
       p.minLobeSharePct > 100 || p.minGradientGrey < 0 || p.minGradientGrey > 255 ||
@@ -83,9 +85,10 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(take(carver, columns_, static_cast<std::size_t>(l.width)));
   step(take(carver, rows_, static_cast<std::size_t>(l.height)));
   step(take(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
+  step(take(carver, filterRows_, demux::FilterRows::valuesFor(l.width)));
   step(take(carver, tileHistograms_, tiles * demux::kBins));
-  step(take(carver, sampleAngles_, samples));
-  step(take(carver, sampleWeights_, samples));
+  step(take(carver, sampleAngles_, samples * 3));
+  step(take(carver, sampleWeights_, samples * 3));
   step(take(carver, tileColourSums_, tiles * 3));
   step(take(carver, tileInverseColour_, tiles * 3));
   step(take(carver, tileDirections_, tiles * projectors));
@@ -147,7 +150,7 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
     return fail(Errc::kSizeMismatch, "demux: image size differs from the layout");
   }
   const DemuxParams& p = layout_.params;
-  demux::smoothChannels(image, smoothed_, p.smooth, rowScratch_);
+  demux::smoothChannels(image, smoothed_, p.smoothPasses, rowScratch_);
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
   demux::histogramTiles(smoothed_, layout_, sampleAngles_, sampleWeights_, tileHistograms_);
@@ -166,8 +169,9 @@ Result<void> Demultiplexer::separateOnly(int projector) {
     return fail(Errc::kInvalidArgument, "demux: no such projector");
   }
   const auto p = static_cast<std::size_t>(projector);
+  const demux::FilterRows filtered(filterRows_, layout_.width);
   demux::separate(smoothed_, layout_, projector, tileDirections_, tileInverseColour_, columns_,
-                  rows_, units_[0], separated_, order_, directions_[p]);
+                  rows_, units_[0], filtered, separated_, order_, directions_[p]);
   // Q4.11 threshold from per mille.
   const int minStrength = (layout_.params.minStrengthPermille << demux::kRelativeShift) / 1000;
   demux::detectBoundaries(separated_, order_, directions_[p], units_[0], minStrength, strength_,

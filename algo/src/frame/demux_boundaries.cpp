@@ -91,7 +91,7 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
                       ImageView<std::uint16_t> strength, BoundaryPlane out) {
   const int w = separated[0].width();
   const int h = separated[0].height();
-  constexpr int kMargin = 2;  // responses and their neighbours stay inside the plane
+  constexpr int kMargin = 3;  // responses and their neighbours stay inside the separated area
 
   for (int y = 0; y < h; ++y) {
     std::uint16_t* s = strength.rowPtr(y);
@@ -128,6 +128,14 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
       const std::int32_t ahead = sampleQ8(st, xq + (ux >> 6), yq + (uy >> 6));
       const std::int32_t behind = sampleQ8(st, xq - (ux >> 6), yq - (uy >> 6));
       if (s0 < ahead || s0 <= behind) {
+        continue;
+      }
+      // A second-order response has side lobes of about half the peak two pixels out, with the
+      // reversed class: such a maximum must also beat the samples two pixels away.
+      if (o[x] == 2 && y >= kMargin + 2 && y < h - kMargin - 2 && x >= kMargin + 2 &&
+          x < w - kMargin - 2 &&
+          (s0 < sampleQ8(st, xq + (ux >> 5), yq + (uy >> 5)) ||
+           s0 <= sampleQ8(st, xq - (ux >> 5), yq - (uy >> 5)))) {
         continue;
       }
       const std::int32_t den = ahead + behind - 2 * s0;  // < 0 at a strict maximum

@@ -1,8 +1,10 @@
 // Stage 2: local stripe-encoding directions (paper §3.2).
-//   Per sample pixel: the colour structure tensor's doubled-angle vector
-//     a = Σ_c (gx² − gy²),  b = Σ_c 2·gx·gy   (g from central differences of S: 32 × grey/px)
-//   in int64; its angle (atan2, BinAngle) and weight √|(a, b)| (the gradient magnitude of a
-//   coherent edge; |(a, b)| by the octagonal norm, −2.8 % … +6.8 %; saturates at uint16).
+//   Per sample pixel and channel (the paper histograms each channel's gradients: summing the
+//   channels' tensors would cancel two patterns 90° apart): g by the matched 5-tap filters of
+//   separate() (int32, then scaled to 2 × ∂S = 32 × grey/px, |g| < 2^14: central differences
+//   bias the orientation of oblique stripes by degrees), its doubled angle (atan2 then ×2,
+//   BinAngle) and weight |g| (isqrt of gx² + gy² in uint32); gradients below minGradientGrey
+//   count nothing.
 //   Per tile: a 64-bin histogram of the samples' doubled angles, weighted.
 //   Per tile window (windowTiles² tiles): lobes are maxima of π/2-wide angle windows stepped by
 //   π/4 that are not at a window edge; each is refined by two mean-shift steps (weighted mean of
@@ -19,30 +21,15 @@ namespace {
 
 constexpr int kRefineHalfWidth = 2 * kBinRaw;  // ±11.25° doubled, ±5.6° of orientation
 constexpr int kMaxLobes = 8;
-
-std::uint64_t abs64(std::int64_t v) {
-  return v < 0 ? static_cast<std::uint64_t>(-(v + 1)) + 1U : static_cast<std::uint64_t>(v);
-}
-
-// Octagonal approximation of |(a, b)|: max + 3/8·min.
-std::uint64_t approxNorm(std::int64_t a, std::int64_t b) {
-  std::uint64_t x = abs64(a);
-  std::uint64_t y = abs64(b);
-  if (x < y) {
-    const std::uint64_t t = x;
-    x = y;
-    y = t;
-  }
-  return x + (3 * y) / 8;
-}
+constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
 std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
   return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
 }
 
 struct Lobe {
+  std::uint64_t weight = 0;  // histogram mass within ±kShareBins of the peak
   std::uint16_t angle2 = 0;  // refined doubled angle
-  std::uint64_t weight = 0;  // sample weight within ±kRefineHalfWidth
   bool used = false;
 };
 
@@ -59,9 +46,10 @@ Lobe refine(std::uint16_t centre, const Window& win, const SampleGrid& grid,
     std::int64_t moment = 0;
     std::uint64_t mass = 0;
     for (int sy = win.sy0; sy < win.sy1; ++sy) {
-      const std::size_t row = static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
-      for (int sx = win.sx0; sx < win.sx1; ++sx) {
-        const std::size_t i = row + static_cast<std::size_t>(sx);
+      const std::size_t row =
+          static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width) * 3;
+      for (std::size_t i = row + static_cast<std::size_t>(win.sx0) * 3;
+           i < row + static_cast<std::size_t>(win.sx1) * 3; ++i) {
         const std::uint16_t w = weights[i];
         if (w == 0) {
           continue;
@@ -98,8 +86,8 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
   const int h = layout.height;
   const int t = layout.params.tilePx;
   const int tilesX = layout.tilesX();
-  const std::int64_t minGrad = std::int64_t{layout.params.minGradientGrey} * 2 * kSmoothScale;
-  const auto minNorm = static_cast<std::uint64_t>(minGrad * minGrad);
+  const std::int32_t minGrad = layout.params.minGradientGrey * 2 * kSmoothScale;
+  const auto minNorm2 = static_cast<std::uint32_t>(minGrad * minGrad);
   for (auto& bin : tileHistograms) {
     bin = 0;
   }
@@ -109,33 +97,44 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
     for (int sx = 0; sx < grid.width; ++sx) {
       const int x = sx * grid.stride;
       const std::size_t si = sampleRow + static_cast<std::size_t>(sx);
-      sampleWeights[si] = 0;
-      sampleAngles[si] = 0;
-      if (x < 1 || y < 1 || x + 1 >= w || y + 1 >= h) {
+      if (x < 2 || y < 2 || x + 2 >= w || y + 2 >= h) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          sampleWeights[si * 3 + c] = 0;
+          sampleAngles[si * 3 + c] = 0;
+        }
         continue;
       }
-      std::int64_t a = 0;
-      std::int64_t b = 0;
-      for (const auto& plane : smoothed) {
-        const std::int16_t* row = plane.rowPtr(y);
-        const std::int32_t gx = row[x + 1] - row[x - 1];
-        const std::int32_t gy = plane.rowPtr(y + 1)[x] - plane.rowPtr(y - 1)[x];
-        a += std::int64_t{gx} * gx - std::int64_t{gy} * gy;
-        b += 2 * std::int64_t{gx} * gy;
-      }
-      const std::uint64_t norm = approxNorm(a, b);
-      if (norm < minNorm) {
-        continue;
-      }
-      const std::uint64_t root = isqrt(norm);
-      const std::uint16_t weight = root > 65535U ? std::uint16_t{65535} : static_cast<std::uint16_t>(root);
-      const std::uint16_t angle = atan2(b, a).raw;
-      sampleWeights[si] = weight;
-      sampleAngles[si] = angle;
       const std::size_t tile = static_cast<std::size_t>(y / t) * static_cast<std::size_t>(tilesX) +
                                static_cast<std::size_t>(x / t);
-      const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
-      tileHistograms[tile * kBins + bin] += weight;
+      std::uint32_t* hist = tileHistograms.data() + tile * kBins;
+      for (std::size_t c = 0; c < 3; ++c) {
+        // The matched 5-tap gradient (as separate() steers it), scaled to 2 × ∂S.
+        std::int32_t accX = 0;
+        std::int32_t accY = 0;
+        for (std::size_t k = 0; k < 5; ++k) {
+          const std::int16_t* row = smoothed[c].rowPtr(y + static_cast<int>(k) - 2) + x;
+          const std::int32_t pre = kPre[0] * (row[-2] + row[2]) + kPre[1] * (row[-1] + row[1]) +
+                                   kPre[2] * row[0];
+          const std::int32_t d1 = kD1[3] * (row[1] - row[-1]) + kD1[4] * (row[2] - row[-2]);
+          accX += kPre[k] * d1;
+          accY += kD1[k] * pre;
+        }
+        const std::int32_t gx = accX >> kDerivShift;
+        const std::int32_t gy = accY >> kDerivShift;
+        const auto norm2 = static_cast<std::uint32_t>(gx * gx + gy * gy);
+        const std::size_t i = si * 3 + c;
+        if (norm2 < minNorm2) {
+          sampleWeights[i] = 0;
+          sampleAngles[i] = 0;
+          continue;
+        }
+        const auto weight = static_cast<std::uint16_t>(isqrt(norm2));
+        const std::uint16_t angle = atan2(gy, gx).doubled().raw;
+        sampleWeights[i] = weight;
+        sampleAngles[i] = angle;
+        const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
+        hist[bin] += weight;
+      }
     }
   }
 }
@@ -209,6 +208,13 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
           peakBins[lobeCount] = bin;
           lobes[lobeCount] = refine(static_cast<std::uint16_t>(bin * kBinRaw), win, grid,
                                     sampleAngles, sampleWeights);
+          // The lobe's mass: the window histogram within ±kShareBins of the refined peak.
+          const int centre = ((lobes[lobeCount].angle2 + kBinRaw / 2) / kBinRaw) % kBins;
+          std::uint64_t mass = 0;
+          for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
+            mass += hist[(k + kBins) % kBins];
+          }
+          lobes[lobeCount].weight = mass;
           ++lobeCount;
         }
       }

@@ -38,11 +38,21 @@ class UnitTable {
   std::array<std::int16_t, kEntries> cos_{};
 };
 
+// Matched 5-tap prefilter / first / second derivative (Farid & Simoncelli's, in integers, the
+// second derivative adjusted so that Σ j²·d2 / 2 · Σ p = (Σ j·d1)², i.e. d2⊗p, p⊗d2 and d1⊗d1
+// measure ∂xx, ∂yy and ∂xy on one scale: 66 560 and 66 564 per unit): directional derivatives
+// steered from them cancel a pattern at any angle, where 3-point differences leak several
+// per cent of it.
+inline constexpr std::array<std::int32_t, 5> kPre = {8, 64, 112, 64, 8};
+inline constexpr std::array<std::int32_t, 5> kD1 = {-27, -75, 0, 75, 27};
+inline constexpr std::array<std::int32_t, 5> kD2 = {65, 0, -130, 0, 65};
+inline constexpr int kDerivShift = 15;  // filter scale / 2: D values are 2 × the S derivative
+
 using Planes3 = std::array<ImageView<std::int16_t>, 3>;
 
-// Stage 1: S_c = [1 2 1]ᵀ[1 2 1] * I_c (edges repeated), i.e. 16 × the binomially smoothed
-// grey level (0…4080); without smoothing 16 × I_c. rowScratch holds 2 × width values.
-void smoothChannels(ConstRgbView image, const Planes3& out, bool smooth,
+// Stage 1: S_c = 16 × I_c smoothed by `passes` 3×3 binomial passes (edges repeated; 0 passes:
+// unsmoothed). rowScratch holds 2 × width values.
+void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch);
 
 // Per tile and channel, Σ S over the tile's pixels.
@@ -82,13 +92,28 @@ struct TileInterp {
 };
 void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
 
+// The ring of horizontally filtered rows separate() streams through: 5 rows × 3 channels ×
+// (prefilter, first, second derivative) × width int32.
+class FilterRows {
+ public:
+  static constexpr int kSlots = 5;
+  FilterRows() = default;
+  FilterRows(std::span<std::int32_t> memory, int width);
+  [[nodiscard]] static std::size_t valuesFor(int width);
+  [[nodiscard]] std::int32_t* row(int slot, int channel, int filter) const;
+
+ private:
+  std::span<std::int32_t> memory_;
+  std::size_t width_ = 0;
+};
+
 // Stages 3–4 for one projector: separated, colour-normalised derivative per channel (Q4.11),
 // the derivative order per pixel (1 or 2; 0 on the border) and the projector's direction plane.
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const Planes3& separated, ImageView<std::uint8_t> order,
-              DirectionPlane direction);
+              const UnitTable& units, const FilterRows& filtered, const Planes3& separated,
+              ImageView<std::uint8_t> order, DirectionPlane direction);
 
 // Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
 // suppression along the encoding direction, sub-pixel offset and class.

@@ -2,14 +2,18 @@
 // locally averaged colour (§4.3).
 //   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
 //   to the pixel; unit vectors Q1.14 from the table. Presence: the nearest tile's.
-//   First order  D_c = v · (gx, gy)_c, gx = S(x+1) − S(x−1): 32 × grey/px; v = the projector's
-//                own axis (no other pattern present) or the normal of the other pattern's axis,
-//                signed towards this projector's axis (so the surviving term keeps its sign).
-//   Second order D_c = ½ · vᵀ H_c w with H = 4 × (Sxx, Sxy; Sxy, Syy) from 3×3 differences;
-//                v, w the normals of the two other patterns' axes, signed likewise.
+//   Derivatives of S by matched 5-tap separable filters (below), row-streamed: the horizontal
+//   filters of rows y − 2 … y + 2 are kept in a ring (int32), the vertical ones applied per pixel
+//   in int64. D values are 2 × the derivative of S (32 × grey/px for the first order).
+//   First order  D_c = v · (gx, gy)_c; v = the projector's own axis (no other pattern present)
+//                or the normal of the other pattern's axis, signed towards this projector's
+//                axis (so the surviving term keeps its sign).
+//   Second order D_c = vᵀ H_c w; v, w the normals of the two other patterns' axes, signed
+//                likewise.
 //   Products of Q1.14 coefficients in int64, one shift each. Normalised value
 //   N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour, saturated to
 //   int16.
+#include <array>
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -66,11 +70,44 @@ void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> 
   }
 }
 
+namespace {
+
+
+// The three horizontal filters of one row of one channel, for x in [2, w − 3].
+void filterRow(const std::int16_t* s, int w, std::int32_t* pre, std::int32_t* d1,
+               std::int32_t* d2) {
+  for (int x = 2; x + 2 < w; ++x) {
+    const std::int32_t m2 = s[x - 2];
+    const std::int32_t m1 = s[x - 1];
+    const std::int32_t c0 = s[x];
+    const std::int32_t p1 = s[x + 1];
+    const std::int32_t p2 = s[x + 2];
+    pre[x] = kPre[0] * (m2 + p2) + kPre[1] * (m1 + p1) + kPre[2] * c0;
+    d1[x] = kD1[3] * (p1 - m1) + kD1[4] * (p2 - m2);
+    d2[x] = kD2[0] * (m2 + p2) + kD2[2] * c0;
+  }
+}
+
+}  // namespace
+
+FilterRows::FilterRows(std::span<std::int32_t> memory, int width)
+    : memory_(memory), width_(static_cast<std::size_t>(width)) {}
+
+std::size_t FilterRows::valuesFor(int width) {
+  return static_cast<std::size_t>(kSlots) * 3 * 3 * static_cast<std::size_t>(width);
+}
+
+std::int32_t* FilterRows::row(int slot, int channel, int filter) const {
+  const auto index = (static_cast<std::size_t>(slot) * 3 + static_cast<std::size_t>(channel)) * 3 +
+                     static_cast<std::size_t>(filter);
+  return memory_.data() + index * width_;
+}
+
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const Planes3& separated, ImageView<std::uint8_t> order,
-              DirectionPlane direction) {
+              const UnitTable& units, const FilterRows& filtered, const Planes3& separated,
+              ImageView<std::uint8_t> order, DirectionPlane direction) {
   const int w = layout.width;
   const int h = layout.height;
   const int projectors = layout.projectors;
@@ -82,14 +119,29 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
                  static_cast<std::size_t>(tx)];
   };
   constexpr int kNormShift = kInverseShift - kRelativeShift;
+  // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
+  const auto slotOf = [](int row) { return (row + FilterRows::kSlots) % FilterRows::kSlots; };
+  const auto fill = [&](int row) {
+    for (int c = 0; c < 3; ++c) {
+      const int slot = slotOf(row);
+      filterRow(smoothed[static_cast<std::size_t>(c)].rowPtr(row), w, filtered.row(slot, c, 0),
+                filtered.row(slot, c, 1), filtered.row(slot, c, 2));
+    }
+  };
+  for (int row = 0; row < 4 && row < h; ++row) {
+    fill(row);
+  }
 
   for (int y = 0; y < h; ++y) {
+    if (y + 2 < h && y >= 2) {
+      fill(y + 2);
+    }
     std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y),
                             separated[2].rowPtr(y)};
     std::uint8_t* orderRow = order.rowPtr(y);
     std::uint16_t* dirRow = direction.rowPtr(y);
     const TileInterp& ry = rows[static_cast<std::size_t>(y)];
-    const bool borderRow = y == 0 || y + 1 == h;
+    const bool borderRow = y < 2 || y + 2 >= h;
     for (int x = 0; x < w; ++x) {
       const TileInterp& cx = columns[static_cast<std::size_t>(x)];
       // Directions of every projector at this pixel.
@@ -108,7 +160,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
         present[p] = tileAt(p, cx.nearest, ry.nearest).present != 0;
       }
       dirRow[x] = angle[projector];
-      if (borderRow || x == 0 || x + 1 == w) {
+      if (borderRow || x < 2 || x + 2 >= w) {
         out[0][x] = out[1][x] = out[2][x] = 0;
         orderRow[x] = 0;
         continue;
@@ -125,29 +177,39 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
           (static_cast<std::size_t>(ry.nearest) * static_cast<std::size_t>(tilesX) +
            static_cast<std::size_t>(cx.nearest)) *
           3;
-      for (std::size_t c = 0; c < 3; ++c) {
-        const ImageView<std::int16_t>& s = smoothed[c];
-        const std::int16_t* up = s.rowPtr(y - 1);
-        const std::int16_t* mid = s.rowPtr(y);
-        const std::int16_t* down = s.rowPtr(y + 1);
+      for (int c = 0; c < 3; ++c) {
+        // Vertical halves of the separable filters over rows y − 2 … y + 2.
         std::int64_t d = 0;
         if (otherCount < 2) {
           const Vec v = otherCount == 0 ? own : others[0];
-          const std::int64_t gx = mid[x + 1] - mid[x - 1];
-          const std::int64_t gy = down[x] - up[x];
-          d = (v.x * gx + v.y * gy) >> kUnitShift;
+          std::int64_t gx = 0;
+          std::int64_t gy = 0;
+          for (int k = 0; k < 5; ++k) {
+            const int slot = slotOf(y + k - 2);
+            gx += std::int64_t{kPre[static_cast<std::size_t>(k)]} * filtered.row(slot, c, 1)[x];
+            gy += std::int64_t{kD1[static_cast<std::size_t>(k)]} * filtered.row(slot, c, 0)[x];
+          }
+          d = (v.x * gx + v.y * gy) >> (kUnitShift + kDerivShift);
         } else {
-          const std::int64_t hxx = 4 * (mid[x + 1] - 2 * mid[x] + mid[x - 1]);
-          const std::int64_t hyy = 4 * (down[x] - 2 * mid[x] + up[x]);
-          const std::int64_t hxy = down[x + 1] - down[x - 1] - up[x + 1] + up[x - 1];
+          std::int64_t hxx = 0;
+          std::int64_t hyy = 0;
+          std::int64_t hxy = 0;
+          for (int k = 0; k < 5; ++k) {
+            const int slot = slotOf(y + k - 2);
+            const auto kk = static_cast<std::size_t>(k);
+            hxx += std::int64_t{kPre[kk]} * filtered.row(slot, c, 2)[x];
+            hyy += std::int64_t{kD2[kk]} * filtered.row(slot, c, 0)[x];
+            hxy += std::int64_t{kD1[kk]} * filtered.row(slot, c, 1)[x];
+          }
           const Vec& v = others[0];
           const Vec& u = others[1];
           const std::int64_t cxx = std::int64_t{v.x} * u.x;
           const std::int64_t cyy = std::int64_t{v.y} * u.y;
           const std::int64_t cxy = std::int64_t{v.x} * u.y + std::int64_t{v.y} * u.x;
-          d = (cxx * hxx + cxy * hxy + cyy * hyy) >> (2 * kUnitShift + 1);
+          d = (cxx * hxx + cxy * hxy + cyy * hyy) >> (2 * kUnitShift + kDerivShift);
         }
-        out[c][x] = saturate16((d * inverseColour[colourTile + c]) >> kNormShift);
+        out[c][x] = saturate16((d * inverseColour[colourTile + static_cast<std::size_t>(c)]) >>
+                               kNormShift);
       }
       orderRow[x] = otherCount < 2 ? 1 : 2;
     }

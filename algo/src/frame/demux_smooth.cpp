@@ -1,6 +1,7 @@
 // Stage 1 and the colour averages of stage 4.
 //   Input   8-bit RGB.
-//   Output  int16 planes, 16 × smoothed grey (0…4080): the [1 2 1] kernel sums to 4 per pass.
+//   Output  int16 planes, 16 × smoothed grey (0…4080): the 3×3 binomial kernel sums to 16; a
+//           second pass (5×5 binomial overall, σ = 1 px) is rounded back by >> 4.
 //   Accumulators int32 (tile sums uint32: a 64×64 tile of 4080 is < 2^24). Nothing saturates.
 #include <cstdint>
 
@@ -10,45 +11,49 @@ namespace smx::algo::demux {
 
 namespace {
 
-// Horizontal pass of one channel of one row into dst (values 0…1020).
 template <int Channel>
-void horizontal(const Rgb8* src, int width, std::int16_t* dst) {
-  const auto at = [src](int x) {
-    const std::uint8_t* p = &src[x].r;
-    return static_cast<int>(p[Channel]);
-  };
-  if (width == 1) {
-    dst[0] = static_cast<std::int16_t>(4 * at(0));
-    return;
+void copyChannel(ConstRgbView image, ImageView<std::int16_t> out, int scale) {
+  for (int y = 0; y < image.height(); ++y) {
+    const Rgb8* src = image.rowPtr(y);
+    std::int16_t* dst = out.rowPtr(y);
+    for (int x = 0; x < image.width(); ++x) {
+      const std::uint8_t* p = &src[x].r;
+      dst[x] = static_cast<std::int16_t>(scale * p[Channel]);
+    }
   }
-  dst[0] = static_cast<std::int16_t>(3 * at(0) + at(1));
-  for (int x = 1; x + 1 < width; ++x) {
-    dst[x] = static_cast<std::int16_t>(at(x - 1) + 2 * at(x) + at(x + 1));
-  }
-  dst[width - 1] = static_cast<std::int16_t>(at(width - 2) + 3 * at(width - 1));
 }
 
-template <int Channel>
-void smoothChannel(ConstRgbView image, ImageView<std::int16_t> out, std::int16_t* prev,
-                   std::int16_t* cur) {
-  const int w = image.width();
-  const int h = image.height();
+// One [1 2 1]ᵀ[1 2 1] pass in place, edges repeated, result (sum + half) >> shift.
+// scratch holds 2 × width values.
+void binomialPass(ImageView<std::int16_t> plane, int shift, std::int16_t* prev,
+                  std::int16_t* cur) {
+  const int w = plane.width();
+  const int h = plane.height();
+  const std::int32_t half = shift > 0 ? 1 << (shift - 1) : 0;
   for (int y = 0; y < h; ++y) {
-    horizontal<Channel>(image.rowPtr(y), w, out.rowPtr(y));
-  }
-  // Vertical pass in place: row y needs the horizontal rows y−1 (kept in prev), y and y+1.
-  const std::int16_t* first = out.rowPtr(0);
-  for (int x = 0; x < w; ++x) {
-    prev[x] = first[x];
-  }
-  for (int y = 0; y < h; ++y) {
-    std::int16_t* row = out.rowPtr(y);
-    const std::int16_t* next = y + 1 < h ? out.rowPtr(y + 1) : row;
+    std::int16_t* row = plane.rowPtr(y);
     for (int x = 0; x < w; ++x) {
       cur[x] = row[x];
     }
     for (int x = 0; x < w; ++x) {
-      row[x] = static_cast<std::int16_t>(prev[x] + 2 * cur[x] + next[x]);
+      const std::int32_t left = cur[x > 0 ? x - 1 : 0];
+      const std::int32_t right = cur[x + 1 < w ? x + 1 : w - 1];
+      row[x] = static_cast<std::int16_t>(left + 2 * cur[x] + right);
+    }
+  }
+  // Vertical: row y needs the horizontal rows y−1 (kept in prev), y and y+1.
+  const std::int16_t* first = plane.rowPtr(0);
+  for (int x = 0; x < w; ++x) {
+    prev[x] = first[x];
+  }
+  for (int y = 0; y < h; ++y) {
+    std::int16_t* row = plane.rowPtr(y);
+    const std::int16_t* next = y + 1 < h ? plane.rowPtr(y + 1) : row;
+    for (int x = 0; x < w; ++x) {
+      cur[x] = row[x];
+    }
+    for (int x = 0; x < w; ++x) {
+      row[x] = static_cast<std::int16_t>((prev[x] + 2 * cur[x] + next[x] + half) >> shift);
     }
     std::int16_t* t = prev;
     prev = cur;
@@ -56,34 +61,21 @@ void smoothChannel(ConstRgbView image, ImageView<std::int16_t> out, std::int16_t
   }
 }
 
-template <int Channel>
-void copyChannel(ConstRgbView image, ImageView<std::int16_t> out) {
-  for (int y = 0; y < image.height(); ++y) {
-    const Rgb8* src = image.rowPtr(y);
-    std::int16_t* dst = out.rowPtr(y);
-    for (int x = 0; x < image.width(); ++x) {
-      const std::uint8_t* p = &src[x].r;
-      dst[x] = static_cast<std::int16_t>(kSmoothScale * p[Channel]);
-    }
-  }
-}
-
 }  // namespace
 
-void smoothChannels(ConstRgbView image, const Planes3& out, bool smooth,
+void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch) {
-  if (!smooth) {
-    copyChannel<0>(image, out[0]);
-    copyChannel<1>(image, out[1]);
-    copyChannel<2>(image, out[2]);
-    return;
-  }
+  const int scale = passes > 0 ? 1 : kSmoothScale;
+  copyChannel<0>(image, out[0], scale);
+  copyChannel<1>(image, out[1], scale);
+  copyChannel<2>(image, out[2], scale);
   const auto w = static_cast<std::size_t>(image.width());
-  std::int16_t* a = rowScratch.data();
-  std::int16_t* b = a + w;
-  smoothChannel<0>(image, out[0], a, b);
-  smoothChannel<1>(image, out[1], a, b);
-  smoothChannel<2>(image, out[2], a, b);
+  for (const auto& plane : out) {
+    for (int pass = 0; pass < passes; ++pass) {
+      // The first pass takes 0…255 to 16 × grey; later ones keep that scale.
+      binomialPass(plane, pass == 0 ? 0 : 4, rowScratch.data(), rowScratch.data() + w);
+    }
+  }
 }
 
 void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t> sums) {

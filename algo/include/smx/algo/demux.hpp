@@ -15,7 +15,7 @@
 // each projector's stripe boundaries with their colour transitions.
 //
 // Stages, all per frame, integer-only and allocation-free (src/frame/demux_*.cpp):
-//   1. binomial 3×3 smoothing of each channel (×16 fixed point);
+//   1. binomial smoothing of each channel (×16 fixed point);
 //   2. per tile, the magnitude-weighted histogram of doubled gradient angles over a window of
 //      tiles; its lobes, refined by a local weighted mean, are matched to each projector's
 //      predicted encoding direction (sign and identity come from the rig);
@@ -36,9 +36,9 @@ struct DemuxParams {
   int histogramStride = 2;     // gradients sampled every n-th pixel in x and y for the histogram
   int minGradientGrey = 4;     // gradient magnitude (grey levels per pixel) counted in histograms
   int lobeToleranceDeg = 25;   // a lobe is a projector's if within this of its predicted axis
-  int minLobeSharePct = 12;    // and holds at least this share of the window's weight
+  int minLobeSharePct = 8;     // and holds at least this share of the window's weight
   int minStrengthPermille = 80;  // boundary strength, relative to the local average colour
-  bool smooth = true;          // step 1
+  int smoothPasses = 1;        // step 1: 3×3 binomial passes (σ 0.7 px; two: σ 1 px)
   bool normaliseColour = true;  // step 4
 };
 
@@ -109,8 +109,9 @@ class Demultiplexer {
   std::span<demux::TileInterp> columns_;
   std::span<demux::TileInterp> rows_;
   std::span<std::int16_t> rowScratch_;
+  std::span<std::int32_t> filterRows_;           // separate()'s ring of filtered rows
   std::span<std::uint32_t> tileHistograms_;      // tileCount × 64 bins
-  std::span<std::uint16_t> sampleAngles_;        // doubled angle per histogram sample
+  std::span<std::uint16_t> sampleAngles_;        // doubled angle per histogram sample, ×3 channels
   std::span<std::uint16_t> sampleWeights_;       // weight per histogram sample (0: none)
   std::span<std::uint32_t> tileColourSums_;      // tileCount × 3
   std::span<std::uint32_t> tileInverseColour_;   // tileCount × 3: 2^24 / average

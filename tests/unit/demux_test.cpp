@@ -1,0 +1,198 @@
+// Orientation demultiplexing on clean synthetic superpositions (host and aarch64): the layout
+// and its memory, input checks, a frame without heap use, and boundaries where the analytic
+// patterns put them. Accuracy on rendered scenes: demux_accuracy_test.cpp.
+#include "smx/algo/demux.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "smx/algo/fixed_math.hpp"
+#include "smx/algo/stripe_code.hpp"
+
+namespace smx::algo {
+namespace {
+
+constexpr std::size_t kMiB = std::size_t{1} << 20;
+
+// Patterns as the projector shows them: stripe ⌊s⌋ of width stripePx along (cos a, sin a)
+// through the image centre, s = 99 there. Each pattern adds its primary at `level`.
+struct SyntheticPattern {
+  double angleDeg;
+  double stripePx;
+};
+
+double stripeAt(const SyntheticPattern& p, int w, int h, double x, double y) {
+  const double a = p.angleDeg * std::numbers::pi / 180.0;
+  return ((x - (w - 1) / 2.0) * std::cos(a) + (y - (h - 1) / 2.0) * std::sin(a)) / p.stripePx +
+         99.0;
+}
+
+std::vector<Rgb8> superpose(const std::vector<SyntheticPattern>& patterns, int w, int h,
+                            int level) {
+  std::vector<Rgb8> image(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  // 4 × 4 samples per pixel: the camera integrates over its pixel.
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double acc[3] = {0, 0, 0};
+      for (int sy = 0; sy < 4; ++sy) {
+        for (int sx = 0; sx < 4; ++sx) {
+          for (const auto& p : patterns) {
+            const double s = stripeAt(p, w, h, x - 0.375 + sx * 0.25, y - 0.375 + sy * 0.25);
+            const int k = static_cast<int>(std::floor(s));
+            if (k >= 0 && k < stripe::kStripes) {
+              acc[stripe::indexOf(stripe::kSequence[static_cast<std::size_t>(k)])] += level / 16.0;
+            }
+          }
+        }
+      }
+      auto& px = image[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
+                       static_cast<std::size_t>(x)];
+      px = {static_cast<std::uint8_t>(std::lround(acc[0] + 10)),
+            static_cast<std::uint8_t>(std::lround(acc[1] + 10)),
+            static_cast<std::uint8_t>(std::lround(acc[2] + 10))};
+    }
+  }
+  return image;
+}
+
+// Predicted angles: the exact encoding directions, the same in every tile.
+std::vector<std::uint16_t> exactPrediction(const DemuxLayout& layout,
+                                           const std::vector<SyntheticPattern>& patterns) {
+  std::vector<std::uint16_t> out;
+  for (std::size_t t = 0; t < layout.tileCount(); ++t) {
+    for (const auto& p : patterns) {
+      out.push_back(BinAngle::fromDegrees(p.angleDeg).raw);
+    }
+  }
+  return out;
+}
+
+TEST(Demux, WorkspaceFor640x480FitsTheBudgetAndCreateUsesNoMore) {
+  for (const int projectors : {1, 2, 3}) {
+    const DemuxLayout layout{640, 480, projectors, {}};
+    const auto bytes = Demultiplexer::workspaceBytes(layout);
+    ASSERT_TRUE(bytes.has_value());
+    EXPECT_LE(*bytes, 16 * kMiB) << projectors << " projectors";
+    std::vector<std::byte> memory(*bytes);
+    Arena arena(memory);
+    const std::vector<std::uint16_t> predicted(
+        layout.tileCount() * static_cast<std::size_t>(projectors), 0);
+    auto demux = Demultiplexer::create(layout, predicted, arena);
+    ASSERT_TRUE(demux.has_value()) << demux.error().message;
+    EXPECT_LE(arena.highWater(), *bytes);
+    // One byte less than the report must still be enough, or the report is tight: either way the
+    // report is within alignment slack of what create() used.
+    EXPECT_GE(*bytes, arena.highWater());
+    EXPECT_LT(*bytes - arena.highWater(), 1024U);
+    ::testing::Test::RecordProperty("workspace_bytes_" + std::to_string(projectors),
+                                    std::to_string(*bytes));
+    std::printf("demux workspace 640x480, %d projector(s): %zu bytes (%.2f MiB)\n", projectors,
+                *bytes, static_cast<double>(*bytes) / static_cast<double>(kMiB));
+  }
+}
+
+TEST(Demux, CreateRejectsBadLayoutsAndATooSmallArena) {
+  std::vector<std::byte> memory(1024);
+  Arena arena(memory);
+  const std::vector<std::uint16_t> none;
+  EXPECT_FALSE(Demultiplexer::create({4, 480, 2, {}}, none, arena).has_value());
+  EXPECT_FALSE(Demultiplexer::create({640, 480, 4, {}}, none, arena).has_value());
+  DemuxParams even;
+  even.windowTiles = 2;
+  EXPECT_FALSE(Demultiplexer::workspaceBytes({640, 480, 2, even}).has_value());
+  const DemuxLayout layout{64, 48, 2, {}};
+  const std::vector<std::uint16_t> wrongCount(3, 0);
+  const auto wrong = Demultiplexer::create(layout, wrongCount, arena);
+  ASSERT_FALSE(wrong.has_value());
+  EXPECT_EQ(wrong.error().code, Errc::kSizeMismatch);
+  const std::vector<std::uint16_t> predicted(layout.tileCount() * 2, 0);
+  const auto small = Demultiplexer::create(layout, predicted, arena);
+  ASSERT_FALSE(small.has_value());
+  EXPECT_EQ(small.error().code, Errc::kOutOfMemory);
+  EXPECT_EQ(arena.used(), 0U);  // a failed create() gives its memory back
+}
+
+TEST(Demux, RunRejectsAnImageOfAnotherSize) {
+  const DemuxLayout layout{64, 48, 2, {}};
+  std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
+  Arena arena(memory);
+  const std::vector<std::uint16_t> predicted(layout.tileCount() * 2, 0);
+  auto demux = Demultiplexer::create(layout, predicted, arena);
+  ASSERT_TRUE(demux.has_value());
+  std::vector<Rgb8> pixels(64 * 47);
+  const auto ok = demux->run(*ConstRgbView::packed(pixels, 64, 47));
+  ASSERT_FALSE(ok.has_value());
+  EXPECT_EQ(ok.error().code, Errc::kSizeMismatch);
+}
+
+// Given two clean patterns 90° apart (and, separately, 70° apart), when a frame runs, then each
+// projector's boundaries lie where its stripe coordinate crosses an integer, with the class of
+// the colours on either side, and the frame touched the heap not once.
+class DemuxSynthetic : public ::testing::TestWithParam<std::vector<SyntheticPattern>> {};
+
+TEST_P(DemuxSynthetic, BoundariesAreWhereThePatternsPutThemWithoutHeapUse) {
+  const auto& patterns = GetParam();
+  constexpr int kW = 160;
+  constexpr int kH = 120;
+  const auto image = superpose(patterns, kW, kH, 110);
+  const DemuxLayout layout{kW, kH, static_cast<int>(patterns.size()), {}};
+  std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
+  Arena arena(memory);
+  auto demux = Demultiplexer::create(layout, exactPrediction(layout, patterns), arena);
+  ASSERT_TRUE(demux.has_value());
+  const auto view = *ConstRgbView::packed(image, kW, kH);
+
+  const test::AllocationCounter counter;
+  for (int frame = 0; frame < 3; ++frame) {
+    ASSERT_TRUE(demux->run(view).has_value());
+  }
+  EXPECT_EQ(counter.allocations(), 0U);
+
+  for (std::size_t p = 0; p < patterns.size(); ++p) {
+    const auto& pattern = patterns[p];
+    const double a = pattern.angleDeg * std::numbers::pi / 180.0;
+    int found = 0;
+    int correct = 0;
+    double sumSq = 0;
+    for (int y = 8; y < kH - 8; ++y) {
+      for (int x = 8; x < kW - 8; ++x) {
+        const Boundary b = demux->boundaries(static_cast<int>(p))(x, y);
+        if (!b.present()) {
+          continue;
+        }
+        ++found;
+        const double along = b.offset / 256.0;
+        const double s =
+            stripeAt(pattern, kW, kH, x + along * std::cos(a), y + along * std::sin(a));
+        const int k = static_cast<int>(std::lround(s));
+        const double errorPx = (s - k) * pattern.stripePx;
+        sumSq += errorPx * errorPx;
+        const auto truth =
+            stripe::transitionBetween(stripe::kSequence[static_cast<std::size_t>(k - 1)],
+                                      stripe::kSequence[static_cast<std::size_t>(k)]);
+        correct += (b.kind() == truth && std::abs(errorPx) < 0.5) ? 1 : 0;
+      }
+    }
+    // Boundaries cross every row or column of the inner area about once per stripe width.
+    const double expected = (kW - 16) * (kH - 16) / pattern.stripePx;
+    EXPECT_GT(found, 0.9 * expected) << "projector " << p;
+    EXPECT_LT(found, 1.1 * expected) << "projector " << p;
+    EXPECT_GE(correct, 0.99 * found) << "projector " << p;
+    EXPECT_LT(std::sqrt(sumSq / found), 0.15) << "projector " << p;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Patterns, DemuxSynthetic,
+                         ::testing::Values(std::vector<SyntheticPattern>{{0, 4.0}, {90, 4.0}},
+                                           std::vector<SyntheticPattern>{{10, 4.5}, {80, 4.5}},
+                                           std::vector<SyntheticPattern>{{0, 4.0}, {70, 4.0}}));
+
+}  // namespace
+}  // namespace smx::algo
