@@ -14,6 +14,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   int exitCode = kExitOk;
   addPatternCommand(app, io, exitCode);
   addSimCommand(app, io, exitCode);
+  addDemuxCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -38,7 +38,8 @@ Result<void> validate(const DemuxLayout& l) {
   }
   if (p.lobeToleranceDeg < 1 || p.lobeToleranceDeg > 45 || p.minLobeSharePct < 0 ||
       p.minLobeSharePct > 100 || p.minGradientGrey < 0 || p.minGradientGrey > 255 ||
-      p.minStrengthPermille < 0 || p.minStrengthPermille > 16000) {
+      p.minStrengthPermille < 0 || p.minStrengthPermille > 16000 || p.minContrastGrey < 0 ||
+      p.minContrastGrey > 255) {
     return fail(Errc::kInvalidArgument, "demux: a threshold is out of range");
   }
   return {};
@@ -71,8 +72,7 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   const DemuxLayout& l = layout_;
   const demux::SampleGrid grid = demux::sampleGrid(l);
   const std::size_t tiles = l.tileCount();
-  const auto samples =
-      static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height);
+  const auto samples = static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height);
   const auto projectors = static_cast<std::size_t>(l.projectors);
   Result<void> ok;
   const auto step = [&ok](Result<void> r) {

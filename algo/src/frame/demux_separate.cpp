@@ -13,6 +13,7 @@
 //   Products of Q1.14 coefficients in int64, one shift each. Normalised value
 //   N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour, saturated to
 //   int16.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -72,7 +73,6 @@ void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> 
 
 namespace {
 
-
 // The three horizontal filters of one row of one channel, for x in [2, w − 3].
 void filterRow(const std::int16_t* s, int w, std::int32_t* pre, std::int32_t* d1,
                std::int32_t* d2) {
@@ -119,6 +119,8 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
                  static_cast<std::size_t>(tx)];
   };
   constexpr int kNormShift = kInverseShift - kRelativeShift;
+  // D is 2·∂S = 32 × grey level per pixel.
+  const std::int64_t minContrast = std::int64_t{layout.params.minContrastGrey} * 2 * kSmoothScale;
   // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
   const auto slotOf = [](int row) { return (row + FilterRows::kSlots) % FilterRows::kSlots; };
   const auto fill = [&](int row) {
@@ -136,8 +138,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
     if (y + 2 < h && y >= 2) {
       fill(y + 2);
     }
-    std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y),
-                            separated[2].rowPtr(y)};
+    std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y), separated[2].rowPtr(y)};
     std::uint8_t* orderRow = order.rowPtr(y);
     std::uint16_t* dirRow = direction.rowPtr(y);
     const TileInterp& ry = rows[static_cast<std::size_t>(y)];
@@ -177,6 +178,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
           (static_cast<std::size_t>(ry.nearest) * static_cast<std::size_t>(tilesX) +
            static_cast<std::size_t>(cx.nearest)) *
           3;
+      std::int64_t raw[3] = {0, 0, 0};
       for (int c = 0; c < 3; ++c) {
         // Vertical halves of the separable filters over rows y − 2 … y + 2.
         std::int64_t d = 0;
@@ -208,8 +210,16 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
           const std::int64_t cxy = std::int64_t{v.x} * u.y + std::int64_t{v.y} * u.x;
           d = (cxx * hxx + cxy * hxy + cyy * hyy) >> (2 * kUnitShift + kDerivShift);
         }
-        out[c][x] = saturate16((d * inverseColour[colourTile + static_cast<std::size_t>(c)]) >>
-                               kNormShift);
+        raw[static_cast<std::size_t>(c)] = d;
+      }
+      // Below the contrast floor (noise in shadows and on black) nothing is separated: the
+      // division by a dark average would lift it over the relative threshold.
+      const std::int64_t hi = std::max({raw[0], raw[1], raw[2]});
+      const std::int64_t lo = std::min({raw[0], raw[1], raw[2]});
+      for (std::size_t c = 0; c < 3; ++c) {
+        out[c][x] = hi - lo < minContrast
+                        ? std::int16_t{0}
+                        : saturate16((raw[c] * inverseColour[colourTile + c]) >> kNormShift);
       }
       orderRow[x] = otherCount < 2 ? 1 : 2;
     }

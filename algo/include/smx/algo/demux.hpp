@@ -31,15 +31,16 @@ inline constexpr int kMaxProjectors = 3;
 
 // Tunables, with the defaults the accuracy tests were measured with.
 struct DemuxParams {
-  int tilePx = 8;              // direction / colour-average tile size
-  int windowTiles = 3;         // histogram window: windowTiles × windowTiles tiles (odd)
-  int histogramStride = 2;     // gradients sampled every n-th pixel in x and y for the histogram
-  int minGradientGrey = 4;     // gradient magnitude (grey levels per pixel) counted in histograms
-  int lobeToleranceDeg = 25;   // a lobe is a projector's if within this of its predicted axis
-  int minLobeSharePct = 8;     // and holds at least this share of the window's weight
+  int tilePx = 8;                // direction / colour-average tile size
+  int windowTiles = 3;           // histogram window: windowTiles × windowTiles tiles (odd)
+  int histogramStride = 2;       // gradients sampled every n-th pixel in x and y for the histogram
+  int minGradientGrey = 4;       // gradient magnitude (grey levels per pixel) counted in histograms
+  int lobeToleranceDeg = 25;     // a lobe is a projector's if within this of its predicted axis
+  int minLobeSharePct = 8;       // and holds at least this share of the window's weight
   int minStrengthPermille = 80;  // boundary strength, relative to the local average colour
-  int smoothPasses = 1;        // step 1: 3×3 binomial passes (σ 0.7 px; two: σ 1 px)
-  bool normaliseColour = true;  // step 4
+  int minContrastGrey = 4;       // and in grey levels per pixel (max − min over the channels)
+  int smoothPasses = 1;          // step 1: 3×3 binomial passes (σ 0.7 px; two: σ 1 px)
+  bool normaliseColour = true;   // step 4
 };
 
 // The frame geometry fixed at init: image size, projector count and each projector's predicted
@@ -60,8 +61,8 @@ struct DemuxLayout {
 
 // What the direction stage found in one tile for one projector.
 struct TileDirection {
-  std::uint16_t angle = 0;  // BinAngle raw of the encoding direction (estimated or predicted)
-  std::uint8_t present = 0;  // 1 when the pattern's lobe was found in the tile's window
+  std::uint16_t angle = 0;    // BinAngle raw of the encoding direction (estimated or predicted)
+  std::uint8_t present = 0;   // 1 when the pattern's lobe was found in the tile's window
   std::uint8_t sharePct = 0;  // the lobe's share of the window's gradient weight
 };
 
@@ -105,17 +106,17 @@ class Demultiplexer {
 
   DemuxLayout layout_;
   std::span<std::uint16_t> predicted_;
-  std::span<demux::UnitTable> units_;            // one table
+  std::span<demux::UnitTable> units_;  // one table
   std::span<demux::TileInterp> columns_;
   std::span<demux::TileInterp> rows_;
   std::span<std::int16_t> rowScratch_;
-  std::span<std::int32_t> filterRows_;           // separate()'s ring of filtered rows
-  std::span<std::uint32_t> tileHistograms_;      // tileCount × 64 bins
-  std::span<std::uint16_t> sampleAngles_;        // doubled angle per histogram sample, ×3 channels
-  std::span<std::uint16_t> sampleWeights_;       // weight per histogram sample (0: none)
-  std::span<std::uint32_t> tileColourSums_;      // tileCount × 3
-  std::span<std::uint32_t> tileInverseColour_;   // tileCount × 3: 2^24 / average
-  std::span<TileDirection> tileDirections_;      // projectors × tileCount
+  std::span<std::int32_t> filterRows_;          // separate()'s ring of filtered rows
+  std::span<std::uint32_t> tileHistograms_;     // tileCount × 64 bins
+  std::span<std::uint16_t> sampleAngles_;       // doubled angle per histogram sample, ×3 channels
+  std::span<std::uint16_t> sampleWeights_;      // weight per histogram sample (0: none)
+  std::span<std::uint32_t> tileColourSums_;     // tileCount × 3
+  std::span<std::uint32_t> tileInverseColour_;  // tileCount × 3: 2^24 / average
+  std::span<TileDirection> tileDirections_;     // projectors × tileCount
   std::array<ImageView<std::int16_t>, 3> smoothed_;
   std::array<ImageView<std::int16_t>, 3> separated_;
   ImageView<std::uint16_t> strength_;

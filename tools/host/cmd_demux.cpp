@@ -1,0 +1,187 @@
+// stripemux demux --rig rig.json --image CAM=FILE [--image CAM=FILE ...] [--debug DIR]
+//                 [--nominal-depth M]
+// Runs orientation demultiplexing on camera images and reports, per camera and projector, what
+// it found; --debug writes the stripe-segmentation renderings (docs/cli.md, docs/demux.md).
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "commands.hpp"
+#include "demux_debug.hpp"
+#include "smx/algo/demux.hpp"
+#include "smx/algo/encoding_prediction.hpp"
+#include "smx/protocol/rig_json.hpp"
+#include "smx/sim/png_io.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DemuxOptions {
+  fs::path rig;
+  std::vector<std::string> images;  // CAM=FILE
+  std::optional<fs::path> debug;
+  double nominalDepthM = 0.9;
+};
+
+struct CameraImage {
+  std::size_t camera;
+  fs::path file;
+};
+
+std::expected<std::vector<CameraImage>, std::string> parseImages(
+    const std::vector<std::string>& specs, const algo::Rig& rig) {
+  std::vector<CameraImage> out;
+  for (const auto& spec : specs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
+      return std::unexpected("--image " + spec + ": expected CAMERA=FILE, e.g. cam0=frame.png");
+    }
+    const std::string id = spec.substr(0, eq);
+    std::optional<std::size_t> index;
+    std::string known;
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      index = rig.cameras[c].id == id ? std::optional(c) : index;
+      known += (known.empty() ? "" : ", ") + rig.cameras[c].id;
+    }
+    if (!index) {
+      return std::unexpected("--image " + spec + ": the rig has no camera \"" + id +
+                             "\" (cameras: " + known + ")");
+    }
+    out.push_back({*index, spec.substr(eq + 1)});
+  }
+  return out;
+}
+
+std::expected<void, std::string> writeDebug(const fs::path& dir, const std::string& tag,
+                                            const algo::Demultiplexer& demux, int projector) {
+  const algo::ImageView<const std::int16_t> separated[3] = {demux.separated(0), demux.separated(1),
+                                                            demux.separated(2)};
+  const std::pair<const char*, RgbBuffer> images[] = {
+      {".boundaries.png", renderBoundaries(demux.boundaries(projector))},
+      {".separated.png", renderSeparated(separated)},
+      {".direction.png",
+       renderDirections(demux.directions(projector), demux.boundaries(projector))},
+  };
+  for (const auto& [suffix, image] : images) {
+    if (auto ok = sim::writePngRgb8(dir / (tag + suffix), image.view()); !ok) {
+      return ok;
+    }
+  }
+  return {};
+}
+
+int runDemux(const DemuxOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux demux: " << message << "\n";
+    return code;
+  };
+  const auto rig = protocol::loadRig(opts.rig);
+  if (!rig) {
+    return fail(kExitBadInput, rig.error().message());
+  }
+  const auto images = parseImages(opts.images, *rig);
+  if (!images) {
+    return fail(kExitBadInput, images.error());
+  }
+  if (opts.debug) {
+    std::error_code ec;
+    fs::create_directories(*opts.debug, ec);
+    if (ec) {
+      return fail(kExitDeviceOrIo,
+                  "cannot create debug directory " + opts.debug->string() + ": " + ec.message());
+    }
+  }
+  for (const auto& [cameraIndex, file] : *images) {
+    const algo::Camera& camera = rig->cameras[cameraIndex];
+    const auto image = sim::readPngRgb8(file);
+    if (!image) {
+      return fail(kExitBadInput, image.error());
+    }
+    if (image->width != camera.width || image->height != camera.height) {
+      return fail(kExitBadInput, file.string() + ": image is " + std::to_string(image->width) +
+                                     "x" + std::to_string(image->height) + ", camera " + camera.id +
+                                     " is " + std::to_string(camera.width) + "x" +
+                                     std::to_string(camera.height));
+    }
+    const algo::DemuxLayout layout{
+        camera.width, camera.height, static_cast<int>(rig->projectors.size()), {}};
+    const auto predicted = algo::predictEncodingAngles(*rig, static_cast<int>(cameraIndex), layout,
+                                                       opts.nominalDepthM);
+    if (!predicted) {
+      return fail(kExitBadInput, opts.rig.string() + ": " + predicted.error());
+    }
+    const auto bytes = algo::Demultiplexer::workspaceBytes(layout);
+    if (!bytes) {
+      return fail(kExitBadInput, std::string("demux: ") + bytes.error().message);
+    }
+    std::vector<std::byte> memory(*bytes);
+    algo::Arena arena(memory);
+    auto demux = algo::Demultiplexer::create(layout, *predicted, arena);
+    if (!demux) {
+      return fail(kExitBadInput, std::string("demux: ") + demux.error().message);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    if (auto ok = demux->run(image->view()); !ok) {
+      return fail(kExitBadInput, file.string() + ": " + ok.error().message);
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    io.out << camera.id << " (" << file.string() << "): demultiplexed in " << static_cast<int>(ms)
+           << " ms, " << *bytes / 1024 << " KiB working memory\n";
+    for (int p = 0; p < layout.projectors; ++p) {
+      const auto& projector = rig->projectors[static_cast<std::size_t>(p)];
+      std::size_t boundaries = 0;
+      const auto plane = demux->boundaries(p);
+      for (int y = 0; y < plane.height(); ++y) {
+        for (int x = 0; x < plane.width(); ++x) {
+          boundaries += plane(x, y).present() ? 1U : 0U;
+        }
+      }
+      std::size_t present = 0;
+      for (const auto& tile : demux->tileDirections(p)) {
+        present += tile.present;
+      }
+      io.out << "  " << projector.id << ": " << boundaries << " boundary pixels, pattern found in "
+             << (100 * present) / layout.tileCount() << " % of the image\n";
+      if (opts.debug) {
+        if (auto ok = demux->separateOnly(p); !ok) {
+          return fail(kExitBadInput, ok.error().message);
+        }
+        const std::string tag = projector.id + "." + camera.id;
+        if (auto ok = writeDebug(*opts.debug, tag, *demux, p); !ok) {
+          return fail(kExitDeviceOrIo, ok.error());
+        }
+        io.out << "    wrote "
+               << (*opts.debug / (tag + ".{boundaries,separated,direction}.png")).string() << "\n";
+      }
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void addDemuxCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<DemuxOptions>();
+  auto* cmd = app.add_subcommand(
+      "demux",
+      "Separate the superposed projector patterns in camera images and find their stripes");
+  cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
+  cmd->add_option("--image", opts->images, "CAMERA=FILE: a camera's image (PNG), repeatable")
+      ->required();
+  cmd->add_option("--debug", opts->debug,
+                  "Write per projector and camera: boundaries, separated derivative, direction");
+  cmd->add_option("--nominal-depth", opts->nominalDepthM,
+                  "Depth (m) at which the rig predicts the pattern directions")
+      ->check(CLI::Range(0.05, 100.0));
+  cmd->callback([opts, &io, &exitCode] { exitCode = runDemux(*opts, io); });
+}
+
+}  // namespace smx::host
