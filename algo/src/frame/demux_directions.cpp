@@ -71,6 +71,51 @@ Lobe refine(std::uint16_t centre, const Window& win, const SampleGrid& grid,
   return lobe;
 }
 
+// Where a projector's lobe was not found (its pattern faint or absent), the direction of the
+// tiles around that found it is a better guess than the flat-surface prediction: the mean offset
+// from the prediction over the present tiles within ±kFillRadius tiles, as wrapped differences.
+// Presence stays 0.
+constexpr int kFillRadius = 2;
+
+void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+                     std::span<TileDirection> out) {
+  const int tilesX = layout.tilesX();
+  const int tilesY = layout.tilesY();
+  const std::size_t tileCount = layout.tileCount();
+  const auto projectors = static_cast<std::size_t>(layout.projectors);
+  for (std::size_t p = 0; p < projectors; ++p) {
+    const std::span<TileDirection> tiles = out.subspan(p * tileCount, tileCount);
+    for (int ty = 0; ty < tilesY; ++ty) {
+      for (int tx = 0; tx < tilesX; ++tx) {
+        const auto t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                       static_cast<std::size_t>(tx);
+        if (tiles[t].present != 0) {
+          continue;
+        }
+        std::int32_t sum = 0;
+        std::int32_t count = 0;
+        for (int j = ty - kFillRadius; j <= ty + kFillRadius; ++j) {
+          for (int i = tx - kFillRadius; i <= tx + kFillRadius; ++i) {
+            if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
+              continue;
+            }
+            const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
+                           static_cast<std::size_t>(i);
+            if (tiles[n].present != 0) {
+              sum += wrapDiff(tiles[n].angle, predicted[n * projectors + p]);
+              ++count;
+            }
+          }
+        }
+        if (count > 0) {
+          tiles[t].angle = static_cast<std::uint16_t>(predicted[t * projectors + p] +
+                                                      static_cast<std::uint16_t>(sum / count));
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 SampleGrid sampleGrid(const DemuxLayout& layout) {
@@ -93,7 +138,8 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
   }
   for (int sy = 0; sy < grid.height; ++sy) {
     const int y = sy * grid.stride;
-    const std::size_t sampleRow = static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
+    const std::size_t sampleRow =
+        static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
     for (int sx = 0; sx < grid.width; ++sx) {
       const int x = sx * grid.stride;
       const std::size_t si = sampleRow + static_cast<std::size_t>(sx);
@@ -113,8 +159,8 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
         std::int32_t accY = 0;
         for (std::size_t k = 0; k < 5; ++k) {
           const std::int16_t* row = smoothed[c].rowPtr(y + static_cast<int>(k) - 2) + x;
-          const std::int32_t pre = kPre[0] * (row[-2] + row[2]) + kPre[1] * (row[-1] + row[1]) +
-                                   kPre[2] * row[0];
+          const std::int32_t pre =
+              kPre[0] * (row[-2] + row[2]) + kPre[1] * (row[-1] + row[1]) + kPre[2] * row[0];
           const std::int32_t d1 = kD1[3] * (row[1] - row[-1]) + kD1[4] * (row[2] - row[-2]);
           accX += kPre[k] * d1;
           accY += kD1[k] * pre;
@@ -155,8 +201,8 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
 
   for (int ty = 0; ty < tilesY; ++ty) {
     for (int tx = 0; tx < tilesX; ++tx) {
-      const std::size_t tile =
-          static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) + static_cast<std::size_t>(tx);
+      const std::size_t tile = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                               static_cast<std::size_t>(tx);
       // The window histogram.
       std::uint64_t hist[kBins] = {};
       std::uint64_t total = 0;
@@ -165,9 +211,10 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
           if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
             continue;
           }
-          const std::uint32_t* src =
-              tileHistograms.data() +
-              (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) + static_cast<std::size_t>(i)) * kBins;
+          const std::uint32_t* src = tileHistograms.data() + (static_cast<std::size_t>(j) *
+                                                                  static_cast<std::size_t>(tilesX) +
+                                                              static_cast<std::size_t>(i)) *
+                                                                 kBins;
           for (int k = 0; k < kBins; ++k) {
             hist[k] += src[k];
             total += src[k];
@@ -223,14 +270,35 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       bool assigned[kMaxProjectors] = {false, false, false};
       for (int p = 0; p < projectors; ++p) {
         TileDirection& d = out[static_cast<std::size_t>(p) * tileCount + tile];
-        d.angle = predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
+        d.angle =
+            predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
         d.present = 0;
         d.sharePct = 0;
+      }
+      // Each projector's tolerance: the cap, and at most half the doubled-angle distance to the
+      // nearest other predicted axis (tilted surfaces turn stripes far from the prediction; two
+      // patterns 90° apart allow 45°, three 60° apart 30°).
+      std::int32_t tolerance[kMaxProjectors] = {tolerance2, tolerance2, tolerance2};
+      for (int p = 0; p < projectors; ++p) {
+        const auto pp = static_cast<std::uint16_t>(
+            predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)]
+            << 1U);
+        for (int q = 0; q < projectors; ++q) {
+          if (q == p) {
+            continue;
+          }
+          const auto qq = static_cast<std::uint16_t>(
+              predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(q)]
+              << 1U);
+          std::int32_t apart = wrapDiff(pp, qq);
+          apart = apart < 0 ? -apart : apart;
+          tolerance[p] = apart / 2 < tolerance[p] ? apart / 2 : tolerance[p];
+        }
       }
       for (int round = 0; round < projectors; ++round) {
         int bestP = -1;
         int bestL = -1;
-        std::int32_t bestDiff = tolerance2 + 1;
+        std::int32_t bestDiff = 65536;
         for (int p = 0; p < projectors; ++p) {
           if (assigned[p]) {
             continue;
@@ -244,7 +312,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
             }
             std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
             diff = diff < 0 ? -diff : diff;
-            if (diff < bestDiff) {
+            if (diff <= tolerance[p] && diff < bestDiff) {
               bestDiff = diff;
               bestP = p;
               bestL = l;
@@ -269,6 +337,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       }
     }
   }
+  fillAbsentTiles(layout, predicted, out);
 }
 
 }  // namespace smx::algo::demux

@@ -35,7 +35,7 @@ struct DemuxParams {
   int windowTiles = 3;           // histogram window: windowTiles × windowTiles tiles (odd)
   int histogramStride = 2;       // gradients sampled every n-th pixel in x and y for the histogram
   int minGradientGrey = 4;       // gradient magnitude (grey levels per pixel) counted in histograms
-  int lobeToleranceDeg = 25;     // a lobe is a projector's if within this of its predicted axis
+  int lobeToleranceDeg = 30;     // a lobe is a projector's if within this of its predicted axis
   int minLobeSharePct = 8;       // and holds at least this share of the window's weight
   int minStrengthPermille = 80;  // boundary strength, relative to the local average colour
   int minContrastGrey = 4;       // and in grey levels per pixel (max − min over the channels)
