@@ -20,7 +20,8 @@ std::optional<double> stripeAt(const Camera& cam, const Projector& proj, double 
   }
   // z_cam of origin + s·direction is linear in s: z = (R·origin + t).z + s·(R·direction).z.
   const auto& r = cam.R;
-  const double z0 = r[6] * ray->origin[0] + r[7] * ray->origin[1] + r[8] * ray->origin[2] + cam.t[2];
+  const double z0 =
+      r[6] * ray->origin[0] + r[7] * ray->origin[1] + r[8] * ray->origin[2] + cam.t[2];
   const double dz = r[6] * ray->direction[0] + r[7] * ray->direction[1] + r[8] * ray->direction[2];
   if (!(dz > 0.0)) {
     return std::nullopt;
@@ -74,8 +75,8 @@ std::expected<std::vector<std::uint16_t>, std::string> predictEncodingAngles(
   const int t = layout.params.tilePx;
   for (std::size_t p = 0; p < projectors; ++p) {
     const Projector& proj = rig.projectors[p];
-    const auto centre = angleAt(cam, proj, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0,
-                                nominalDepthM);
+    const auto centre =
+        angleAt(cam, proj, (cam.width - 1) / 2.0, (cam.height - 1) / 2.0, nominalDepthM);
     if (!centre) {
       return std::unexpected("projector " + proj.id + " does not light the centre of camera " +
                              cam.id + " at the nominal depth");

@@ -21,8 +21,12 @@ struct OwnedPlane {
 
   OwnedPlane() = default;
   OwnedPlane(int w, int h, T fill)
-      : width(w), height(h), pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), fill) {}
-  [[nodiscard]] algo::ImageView<T> view() { return *algo::ImageView<T>::packed(pixels, width, height); }
+      : width(w),
+        height(h),
+        pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), fill) {}
+  [[nodiscard]] algo::ImageView<T> view() {
+    return *algo::ImageView<T>::packed(pixels, width, height);
+  }
   [[nodiscard]] algo::ImageView<const T> view() const {
     return *algo::ImageView<const T>::packed(pixels, width, height);
   }

@@ -31,10 +31,11 @@ Result<void> validate(const DemuxLayout& l) {
   }
   if (p.tilePx < 4 || p.tilePx > 64 || p.windowTiles < 1 || p.windowTiles > 9 ||
       p.windowTiles % 2 == 0 || p.histogramStride < 1 || p.histogramStride > 8 ||
-      p.smoothPasses < 0 || p.smoothPasses > 3) {
+      p.smoothPasses < 0 || p.smoothPasses > 3 ||
+      (p.tilePx / p.histogramStride) * (p.tilePx / p.histogramStride) > 64) {
     return fail(Errc::kInvalidArgument,
                 "demux: tilePx 4 to 64, windowTiles odd 1 to 9, histogramStride 1 to 8, "
-                "smoothPasses 0 to 3");
+                "smoothPasses 0 to 3, (tilePx / histogramStride)^2 <= 64");
   }
   if (p.lobeToleranceDeg < 1 || p.lobeToleranceDeg > 45 || p.minLobeSharePct < 0 ||
       p.minLobeSharePct > 100 || p.minGradientGrey < 0 || p.minGradientGrey > 255 ||
@@ -70,9 +71,7 @@ Result<void> takeImage(Carver& carver, ImageView<P>& out, const DemuxLayout& l) 
 template <class Carver>
 Result<void> Demultiplexer::carve(Carver& carver) {
   const DemuxLayout& l = layout_;
-  const demux::SampleGrid grid = demux::sampleGrid(l);
   const std::size_t tiles = l.tileCount();
-  const auto samples = static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height);
   const auto projectors = static_cast<std::size_t>(l.projectors);
   Result<void> ok;
   const auto step = [&ok](Result<void> r) {
@@ -86,9 +85,9 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(take(carver, rows_, static_cast<std::size_t>(l.height)));
   step(take(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
   step(take(carver, filterRows_, demux::FilterRows::valuesFor(l.width)));
+  step(take(carver, derivativeRows_, demux::DerivativeRows::valuesFor(l.width)));
   step(take(carver, tileHistograms_, tiles * demux::kBins));
-  step(take(carver, sampleAngles_, samples * 3));
-  step(take(carver, sampleWeights_, samples * 3));
+  step(take(carver, tileMoments_, tiles * demux::kBins));
   step(take(carver, tileColourSums_, tiles * 3));
   step(take(carver, tileInverseColour_, tiles * 3));
   step(take(carver, tileDirections_, tiles * projectors));
@@ -153,9 +152,12 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::smoothChannels(image, smoothed_, p.smoothPasses, rowScratch_);
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
-  demux::histogramTiles(smoothed_, layout_, sampleAngles_, sampleWeights_, tileHistograms_);
-  demux::estimateDirections(layout_, tileHistograms_, sampleAngles_, sampleWeights_, predicted_,
-                            tileDirections_);
+  demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
+  demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_);
+  demux::interpolateDirections(
+      layout_, tileDirections_, columns_, rows_,
+      std::span<const DirectionPlane>(directions_.data(),
+                                      static_cast<std::size_t>(layout_.projectors)));
   for (int projector = 0; projector < layout_.projectors; ++projector) {
     if (auto ok = separateOnly(projector); !ok) {
       return ok;
@@ -170,8 +172,12 @@ Result<void> Demultiplexer::separateOnly(int projector) {
   }
   const auto p = static_cast<std::size_t>(projector);
   const demux::FilterRows filtered(filterRows_, layout_.width);
+  const demux::DerivativeRows derivs(derivativeRows_, layout_.width);
   demux::separate(smoothed_, layout_, projector, tileDirections_, tileInverseColour_, columns_,
-                  rows_, units_[0], filtered, separated_, order_, directions_[p]);
+                  rows_, units_[0], filtered, derivs,
+                  std::span<const DirectionPlane>(directions_.data(),
+                                                  static_cast<std::size_t>(layout_.projectors)),
+                  separated_, order_);
   // Q4.11 threshold from per mille.
   const int minStrength = (layout_.params.minStrengthPermille << demux::kRelativeShift) / 1000;
   demux::detectBoundaries(separated_, order_, directions_[p], units_[0], minStrength, strength_,

@@ -6,10 +6,14 @@
 //   BinAngle) and weight |g| (isqrt of gx² + gy² in uint32); gradients below minGradientGrey
 //   count nothing.
 //   Per tile: a 64-bin histogram of the samples' doubled angles, weighted.
-//   Per tile window (windowTiles² tiles): lobes are maxima of π/2-wide angle windows stepped by
-//   π/4 that are not at a window edge; each is refined by two mean-shift steps (weighted mean of
-//   the samples' doubled angles within ±kRefineHalfWidth) and matched to the nearest predicted
-//   axis; the doubled angle is halved and its sign taken from the prediction.
+//   Per tile: a 64-bin histogram of the samples' doubled angles, weighted, and per bin the first
+//   moment Σ w·(angle − bin centre) (int32: (tilePx / stride)² · 3 samples of weight < 2^14 and
+//   offset ≤ 2^9 stay below 2^31 for the allowed (tilePx / stride)² ≤ 64).
+//   Per tile window (windowTiles² tiles, sums in 64 bits): lobes are maxima of π/2-wide angle
+//   windows stepped by π/4 that are not at a window edge; each is refined by two mean-shift
+//   steps on the histogram (exact weighted mean of the samples in the bins within ±2 of the
+//   centre) and matched to the nearest predicted axis; the doubled angle is halved and its sign
+//   taken from the prediction.
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -19,7 +23,8 @@ namespace smx::algo::demux {
 
 namespace {
 
-constexpr int kRefineHalfWidth = 2 * kBinRaw;  // ±11.25° doubled, ±5.6° of orientation
+constexpr int kRefineBins = 2;  // mean over ±2 bins: ±14° doubled, ±7° of orientation
+constexpr int kBinShift = 10;   // kBinRaw = 2^10
 constexpr int kMaxLobes = 8;
 constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
@@ -33,41 +38,28 @@ struct Lobe {
   bool used = false;
 };
 
-// Weighted mean of the window's samples within ±kRefineHalfWidth of centre (doubled angles).
-struct Window {
-  int sx0, sy0, sx1, sy1;  // sample index range [sx0, sx1) × [sy0, sy1)
-};
-
-Lobe refine(std::uint16_t centre, const Window& win, const SampleGrid& grid,
-            std::span<const std::uint16_t> angles, std::span<const std::uint16_t> weights) {
+// Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
+// the bins within ±kRefineBins of the current centre, exact from each bin's weight and first
+// moment (Σ w·(angle − bin centre)).
+Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
+            const std::int64_t (&moments)[kBins]) {
   Lobe lobe;
-  lobe.angle2 = centre;
+  std::int32_t centre = peakBin * kBinRaw;  // unwrapped doubled angle
   for (int iteration = 0; iteration < 2; ++iteration) {
+    const std::int32_t centreBin = (centre + kBinRaw / 2) >> kBinShift;  // floor division
     std::int64_t moment = 0;
     std::uint64_t mass = 0;
-    for (int sy = win.sy0; sy < win.sy1; ++sy) {
-      const std::size_t row =
-          static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width) * 3;
-      for (std::size_t i = row + static_cast<std::size_t>(win.sx0) * 3;
-           i < row + static_cast<std::size_t>(win.sx1) * 3; ++i) {
-        const std::uint16_t w = weights[i];
-        if (w == 0) {
-          continue;
-        }
-        const std::int32_t d = wrapDiff(angles[i], lobe.angle2);
-        if (d >= -kRefineHalfWidth && d <= kRefineHalfWidth) {
-          moment += static_cast<std::int64_t>(d) * w;
-          mass += w;
-        }
-      }
+    for (int k = centreBin - kRefineBins; k <= centreBin + kRefineBins; ++k) {
+      const auto bin = static_cast<std::size_t>(k & (kBins - 1));
+      mass += weights[bin];
+      moment += static_cast<std::int64_t>(weights[bin]) * (k * kBinRaw - centre) + moments[bin];
     }
-    lobe.weight = mass;
     if (mass == 0) {
       break;
     }
-    const auto shift = static_cast<std::int32_t>(moment / static_cast<std::int64_t>(mass));
-    lobe.angle2 = static_cast<std::uint16_t>(lobe.angle2 + static_cast<std::uint16_t>(shift));
+    centre += static_cast<std::int32_t>(moment / static_cast<std::int64_t>(mass));
   }
+  lobe.angle2 = static_cast<std::uint16_t>(static_cast<std::uint32_t>(centre) & 0xFFFFU);
   return lobe;
 }
 
@@ -124,8 +116,7 @@ SampleGrid sampleGrid(const DemuxLayout& layout) {
 }
 
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
-                    std::span<std::uint16_t> sampleAngles, std::span<std::uint16_t> sampleWeights,
-                    std::span<std::uint32_t> tileHistograms) {
+                    std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments) {
   const SampleGrid grid = sampleGrid(layout);
   const int w = layout.width;
   const int h = layout.height;
@@ -136,23 +127,20 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
   for (auto& bin : tileHistograms) {
     bin = 0;
   }
+  for (auto& moment : tileMoments) {
+    moment = 0;
+  }
   for (int sy = 0; sy < grid.height; ++sy) {
     const int y = sy * grid.stride;
-    const std::size_t sampleRow =
-        static_cast<std::size_t>(sy) * static_cast<std::size_t>(grid.width);
     for (int sx = 0; sx < grid.width; ++sx) {
       const int x = sx * grid.stride;
-      const std::size_t si = sampleRow + static_cast<std::size_t>(sx);
       if (x < 2 || y < 2 || x + 2 >= w || y + 2 >= h) {
-        for (std::size_t c = 0; c < 3; ++c) {
-          sampleWeights[si * 3 + c] = 0;
-          sampleAngles[si * 3 + c] = 0;
-        }
         continue;
       }
       const std::size_t tile = static_cast<std::size_t>(y / t) * static_cast<std::size_t>(tilesX) +
                                static_cast<std::size_t>(x / t);
       std::uint32_t* hist = tileHistograms.data() + tile * kBins;
+      std::int32_t* moments = tileMoments.data() + tile * kBins;
       for (std::size_t c = 0; c < 3; ++c) {
         // The matched 5-tap gradient (as separate() steers it), scaled to 2 × ∂S.
         std::int32_t accX = 0;
@@ -168,31 +156,24 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
         const std::int32_t gx = accX >> kDerivShift;
         const std::int32_t gy = accY >> kDerivShift;
         const auto norm2 = static_cast<std::uint32_t>(gx * gx + gy * gy);
-        const std::size_t i = si * 3 + c;
         if (norm2 < minNorm2) {
-          sampleWeights[i] = 0;
-          sampleAngles[i] = 0;
           continue;
         }
-        const auto weight = static_cast<std::uint16_t>(isqrt(norm2));
+        const auto weight = static_cast<std::int32_t>(isqrt(norm2));
         const std::uint16_t angle = atan2(gy, gx).doubled().raw;
-        sampleWeights[i] = weight;
-        sampleAngles[i] = angle;
         const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
-        hist[bin] += weight;
+        hist[bin] += static_cast<std::uint32_t>(weight);
+        moments[bin] += weight * wrapDiff(angle, static_cast<std::uint16_t>(bin * kBinRaw));
       }
     }
   }
 }
 
 void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
-                        std::span<const std::uint16_t> sampleAngles,
-                        std::span<const std::uint16_t> sampleWeights,
+                        std::span<const std::int32_t> tileMoments,
                         std::span<const std::uint16_t> predicted, std::span<TileDirection> out) {
-  const SampleGrid grid = sampleGrid(layout);
   const int tilesX = layout.tilesX();
   const int tilesY = layout.tilesY();
-  const int t = layout.params.tilePx;
   const int r = layout.params.windowTiles / 2;
   const int projectors = layout.projectors;
   const std::size_t tileCount = layout.tileCount();
@@ -205,6 +186,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
                                static_cast<std::size_t>(tx);
       // The window histogram.
       std::uint64_t hist[kBins] = {};
+      std::int64_t moment[kBins] = {};
       std::uint64_t total = 0;
       for (int j = ty - r; j <= ty + r; ++j) {
         for (int i = tx - r; i <= tx + r; ++i) {
@@ -215,19 +197,14 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
                                                                   static_cast<std::size_t>(tilesX) +
                                                               static_cast<std::size_t>(i)) *
                                                                  kBins;
+          const std::int32_t* srcMoments = tileMoments.data() + (src - tileHistograms.data());
           for (int k = 0; k < kBins; ++k) {
             hist[k] += src[k];
+            moment[k] += srcMoments[k];
             total += src[k];
           }
         }
       }
-      const auto clampSample = [](int v, int hi) { return v < 0 ? 0 : (v > hi ? hi : v); };
-      const Window win{
-          clampSample(((tx - r) * t + grid.stride - 1) / grid.stride, grid.width),
-          clampSample(((ty - r) * t + grid.stride - 1) / grid.stride, grid.height),
-          clampSample(((tx + r + 1) * t + grid.stride - 1) / grid.stride, grid.width),
-          clampSample(((ty + r + 1) * t + grid.stride - 1) / grid.stride, grid.height)};
-
       // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4).
       Lobe lobes[kMaxLobes];
       int lobeCount = 0;
@@ -253,8 +230,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
             continue;
           }
           peakBins[lobeCount] = bin;
-          lobes[lobeCount] = refine(static_cast<std::uint16_t>(bin * kBinRaw), win, grid,
-                                    sampleAngles, sampleWeights);
+          lobes[lobeCount] = refine(bin, hist, moment);
           // The lobe's mass: the window histogram within ±kShareBins of the refined peak.
           const int centre = ((lobes[lobeCount].angle2 + kBinRaw / 2) / kBinRaw) % kBins;
           std::uint64_t mass = 0;

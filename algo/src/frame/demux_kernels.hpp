@@ -13,13 +13,13 @@
 
 namespace smx::algo::demux {
 
-inline constexpr int kBins = 64;                  // doubled-angle histogram bins (2π)
-inline constexpr int kBinRaw = 65536 / kBins;     // BinAngle raw units per bin
-inline constexpr int kUnitShift = 14;             // unit vectors are Q1.14
+inline constexpr int kBins = 64;               // doubled-angle histogram bins (2π)
+inline constexpr int kBinRaw = 65536 / kBins;  // BinAngle raw units per bin
+inline constexpr int kUnitShift = 14;          // unit vectors are Q1.14
 inline constexpr int kUnit = 1 << kUnitShift;
-inline constexpr int kRelativeShift = 11;         // separated values: Q4.11 of the local average
-inline constexpr int kInverseShift = 24;          // tile inverse colour: 2^24 / average
-inline constexpr int kSmoothScale = 16;           // smoothed planes hold 16 × grey level
+inline constexpr int kRelativeShift = 11;  // separated values: Q4.11 of the local average
+inline constexpr int kInverseShift = 24;   // tile inverse colour: 2^24 / average
+inline constexpr int kSmoothScale = 16;    // smoothed planes hold 16 × grey level
 inline constexpr int kColourFloor = 8 * kSmoothScale;  // averages below 8 grey levels clamp
 
 // A unit vector (Q1.14) from a BinAngle by a 1024-entry table (nearest entry: <= 0.18°).
@@ -62,8 +62,8 @@ void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t
 void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& layout,
                         bool normalise, std::span<std::uint32_t> inverse);
 
-// Stage 2a: the doubled gradient angle and weight of every histogram sample, and each tile's
-// histogram of them.
+// Stage 2a: each tile's histogram of its samples' doubled gradient angles (weights per bin and
+// first moments Σ w·(angle − bin centre) per bin).
 struct SampleGrid {
   int stride = 2;
   int width = 0;   // samples per row
@@ -71,14 +71,12 @@ struct SampleGrid {
 };
 [[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
-                    std::span<std::uint16_t> sampleAngles, std::span<std::uint16_t> sampleWeights,
-                    std::span<std::uint32_t> tileHistograms);
+                    std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments);
 
 // Stage 2b: lobes of each tile's window histogram matched to the predicted directions.
 // out[p * tileCount + t].
 void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
-                        std::span<const std::uint16_t> sampleAngles,
-                        std::span<const std::uint16_t> sampleWeights,
+                        std::span<const std::int32_t> tileMoments,
                         std::span<const std::uint16_t> predicted, std::span<TileDirection> out);
 
 // Bilinear interpolation between tile centres (tile i's centre is pixel i·T + (T−1)/2), per
@@ -107,13 +105,34 @@ class FilterRows {
   std::size_t width_ = 0;
 };
 
-// Stages 3–4 for one projector: separated, colour-normalised derivative per channel (Q4.11),
-// the derivative order per pixel (1 or 2; 0 on the border) and the projector's direction plane.
+// One row of derivatives per channel, separate() steers from: gx, gy, hxx, hyy, hxy (int32).
+class DerivativeRows {
+ public:
+  static constexpr int kKinds = 5;
+  DerivativeRows() = default;
+  DerivativeRows(std::span<std::int32_t> memory, int width);
+  [[nodiscard]] static std::size_t valuesFor(int width);
+  [[nodiscard]] std::int32_t* row(std::size_t channel, int kind) const;
+
+ private:
+  std::span<std::int32_t> memory_;
+  std::size_t width_ = 0;
+};
+
+// Every projector's direction plane: its tile angles interpolated bilinearly between tile
+// centres (as wrapped differences, int64).
+void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
+                           std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+                           std::span<const DirectionPlane> out);
+
+// Stages 3–4 for one projector: separated, colour-normalised derivative per channel (Q4.11) and
+// the derivative order per pixel (1 or 2; 0 on the border).
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const FilterRows& filtered, const Planes3& separated,
-              ImageView<std::uint8_t> order, DirectionPlane direction);
+              const UnitTable& units, const FilterRows& filtered, const DerivativeRows& derivs,
+              std::span<const DirectionPlane> directions, const Planes3& separated,
+              ImageView<std::uint8_t> order);
 
 // Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
 // suppression along the encoding direction, sub-pixel offset and class.

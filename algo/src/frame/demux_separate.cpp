@@ -93,6 +93,17 @@ void filterRow(const std::int16_t* s, int w, std::int32_t* pre, std::int32_t* d1
 FilterRows::FilterRows(std::span<std::int32_t> memory, int width)
     : memory_(memory), width_(static_cast<std::size_t>(width)) {}
 
+DerivativeRows::DerivativeRows(std::span<std::int32_t> memory, int width)
+    : memory_(memory), width_(static_cast<std::size_t>(width)) {}
+
+std::size_t DerivativeRows::valuesFor(int width) {
+  return 3 * std::size_t{kKinds} * static_cast<std::size_t>(width);
+}
+
+std::int32_t* DerivativeRows::row(std::size_t channel, int kind) const {
+  return memory_.data() + (channel * kKinds + static_cast<std::size_t>(kind)) * width_;
+}
+
 std::size_t FilterRows::valuesFor(int width) {
   return static_cast<std::size_t>(kSlots) * 3 * 3 * static_cast<std::size_t>(width);
 }
@@ -103,11 +114,44 @@ std::int32_t* FilterRows::row(int slot, int channel, int filter) const {
   return memory_.data() + index * width_;
 }
 
+void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
+                           std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+                           std::span<const DirectionPlane> out) {
+  const int tilesX = layout.tilesX();
+  const std::size_t tileCount = layout.tileCount();
+  for (int p = 0; p < layout.projectors; ++p) {
+    const std::span<const TileDirection> mine =
+        tiles.subspan(static_cast<std::size_t>(p) * tileCount, tileCount);
+    const auto angleAt = [&](int tx, int ty) {
+      return mine[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                  static_cast<std::size_t>(tx)]
+          .angle;
+    };
+    for (int y = 0; y < layout.height; ++y) {
+      const TileInterp& ry = rows[static_cast<std::size_t>(y)];
+      const std::int64_t wy = ry.weight;
+      std::uint16_t* dst = out[static_cast<std::size_t>(p)].rowPtr(y);
+      for (int x = 0; x < layout.width; ++x) {
+        const TileInterp& cx = columns[static_cast<std::size_t>(x)];
+        const std::uint16_t a00 = angleAt(cx.lower, ry.lower);
+        const std::int64_t d10 = wrapDiff(angleAt(cx.upper, ry.lower), a00);
+        const std::int64_t d01 = wrapDiff(angleAt(cx.lower, ry.upper), a00);
+        const std::int64_t d11 = wrapDiff(angleAt(cx.upper, ry.upper), a00);
+        const std::int64_t wx = cx.weight;
+        const std::int64_t delta =
+            (d10 * wx * (256 - wy) + d01 * (256 - wx) * wy + d11 * wx * wy + 32768) >> 16;
+        dst[x] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
+      }
+    }
+  }
+}
+
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const FilterRows& filtered, const Planes3& separated,
-              ImageView<std::uint8_t> order, DirectionPlane direction) {
+              const UnitTable& units, const FilterRows& filtered, const DerivativeRows& derivs,
+              std::span<const DirectionPlane> directions, const Planes3& separated,
+              ImageView<std::uint8_t> order) {
   const int w = layout.width;
   const int h = layout.height;
   const int projectors = layout.projectors;
@@ -119,8 +163,12 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
                  static_cast<std::size_t>(tx)];
   };
   constexpr int kNormShift = kInverseShift - kRelativeShift;
+  // Row derivatives keep 2^-13 of the filter output (|value| < 2^16); steering by Q1.14
+  // coefficients then shifts by 14 + 2 to reach D = 2·∂S (the filters' unit is 2^15 · 2·∂S).
+  constexpr int kRowShift = 13;
+  constexpr int kSteerShift = kUnitShift + kDerivShift - kRowShift;
   // D is 2·∂S = 32 × grey level per pixel.
-  const std::int64_t minContrast = std::int64_t{layout.params.minContrastGrey} * 2 * kSmoothScale;
+  const std::int32_t minContrast = layout.params.minContrastGrey * 2 * kSmoothScale;
   // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
   const auto slotOf = [](int row) { return (row + FilterRows::kSlots) % FilterRows::kSlots; };
   const auto fill = [&](int row) {
@@ -140,27 +188,54 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
     }
     std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y), separated[2].rowPtr(y)};
     std::uint8_t* orderRow = order.rowPtr(y);
-    std::uint16_t* dirRow = direction.rowPtr(y);
+    const std::uint16_t* dirRows[kMaxProjectors] = {nullptr, nullptr, nullptr};
+    for (int p = 0; p < projectors; ++p) {
+      dirRows[p] = directions[static_cast<std::size_t>(p)].rowPtr(y);
+    }
     const TileInterp& ry = rows[static_cast<std::size_t>(y)];
     const bool borderRow = y < 2 || y + 2 >= h;
+    // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel, for the
+    // whole row (int32, vectorisable), scaled by 2^-13 into int32 range for the steering.
+    const bool second = projectors == kMaxProjectors;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::int32_t* pre[5];
+      const std::int32_t* d1[5];
+      const std::int32_t* d2[5];
+      for (int k = 0; k < 5; ++k) {
+        const int slot = slotOf(y + k - 2);
+        pre[k] = filtered.row(slot, static_cast<int>(c), 0);
+        d1[k] = filtered.row(slot, static_cast<int>(c), 1);
+        d2[k] = filtered.row(slot, static_cast<int>(c), 2);
+      }
+      std::int32_t* gx = derivs.row(c, 0);
+      std::int32_t* gy = derivs.row(c, 1);
+      for (int x = 2; x + 2 < w; ++x) {
+        gx[x] = (kPre[0] * (d1[0][x] + d1[4][x]) + kPre[1] * (d1[1][x] + d1[3][x]) +
+                 kPre[2] * d1[2][x]) >>
+                kRowShift;
+        gy[x] = (kD1[3] * (pre[3][x] - pre[1][x]) + kD1[4] * (pre[4][x] - pre[0][x])) >> kRowShift;
+      }
+      if (second) {
+        std::int32_t* hxx = derivs.row(c, 2);
+        std::int32_t* hyy = derivs.row(c, 3);
+        std::int32_t* hxy = derivs.row(c, 4);
+        for (int x = 2; x + 2 < w; ++x) {
+          hxx[x] = (kPre[0] * (d2[0][x] + d2[4][x]) + kPre[1] * (d2[1][x] + d2[3][x]) +
+                    kPre[2] * d2[2][x]) >>
+                   kRowShift;
+          hyy[x] = (kD2[0] * (pre[0][x] + pre[4][x]) + kD2[2] * pre[2][x]) >> kRowShift;
+          hxy[x] = (kD1[3] * (d1[3][x] - d1[1][x]) + kD1[4] * (d1[4][x] - d1[0][x])) >> kRowShift;
+        }
+      }
+    }
     for (int x = 0; x < w; ++x) {
       const TileInterp& cx = columns[static_cast<std::size_t>(x)];
-      // Directions of every projector at this pixel.
       std::uint16_t angle[kMaxProjectors] = {0, 0, 0};
       bool present[kMaxProjectors] = {false, false, false};
       for (int p = 0; p < projectors; ++p) {
-        const std::uint16_t a00 = tileAt(p, cx.lower, ry.lower).angle;
-        const std::int64_t d10 = wrapDiff(tileAt(p, cx.upper, ry.lower).angle, a00);
-        const std::int64_t d01 = wrapDiff(tileAt(p, cx.lower, ry.upper).angle, a00);
-        const std::int64_t d11 = wrapDiff(tileAt(p, cx.upper, ry.upper).angle, a00);
-        const std::int64_t wx = cx.weight;
-        const std::int64_t wy = ry.weight;
-        const std::int64_t delta =
-            (d10 * wx * (256 - wy) + d01 * (256 - wx) * wy + d11 * wx * wy + 32768) >> 16;
-        angle[p] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
+        angle[p] = dirRows[p][x];
         present[p] = tileAt(p, cx.nearest, ry.nearest).present != 0;
       }
-      dirRow[x] = angle[projector];
       if (borderRow || x < 2 || x + 2 >= w) {
         out[0][x] = out[1][x] = out[2][x] = 0;
         orderRow[x] = 0;
@@ -178,48 +253,34 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
           (static_cast<std::size_t>(ry.nearest) * static_cast<std::size_t>(tilesX) +
            static_cast<std::size_t>(cx.nearest)) *
           3;
-      std::int64_t raw[3] = {0, 0, 0};
-      for (int c = 0; c < 3; ++c) {
-        // Vertical halves of the separable filters over rows y − 2 … y + 2.
-        std::int64_t d = 0;
-        if (otherCount < 2) {
-          const Vec v = otherCount == 0 ? own : others[0];
-          std::int64_t gx = 0;
-          std::int64_t gy = 0;
-          for (int k = 0; k < 5; ++k) {
-            const int slot = slotOf(y + k - 2);
-            gx += std::int64_t{kPre[static_cast<std::size_t>(k)]} * filtered.row(slot, c, 1)[x];
-            gy += std::int64_t{kD1[static_cast<std::size_t>(k)]} * filtered.row(slot, c, 0)[x];
-          }
-          d = (v.x * gx + v.y * gy) >> (kUnitShift + kDerivShift);
-        } else {
-          std::int64_t hxx = 0;
-          std::int64_t hyy = 0;
-          std::int64_t hxy = 0;
-          for (int k = 0; k < 5; ++k) {
-            const int slot = slotOf(y + k - 2);
-            const auto kk = static_cast<std::size_t>(k);
-            hxx += std::int64_t{kPre[kk]} * filtered.row(slot, c, 2)[x];
-            hyy += std::int64_t{kD2[kk]} * filtered.row(slot, c, 0)[x];
-            hxy += std::int64_t{kD1[kk]} * filtered.row(slot, c, 1)[x];
-          }
-          const Vec& v = others[0];
-          const Vec& u = others[1];
-          const std::int64_t cxx = std::int64_t{v.x} * u.x;
-          const std::int64_t cyy = std::int64_t{v.y} * u.y;
-          const std::int64_t cxy = std::int64_t{v.x} * u.y + std::int64_t{v.y} * u.x;
-          d = (cxx * hxx + cxy * hxy + cyy * hyy) >> (2 * kUnitShift + kDerivShift);
+      std::int32_t raw[3] = {0, 0, 0};
+      if (otherCount < 2) {
+        const Vec v = otherCount == 0 ? own : others[0];
+        for (std::size_t c = 0; c < 3; ++c) {
+          raw[c] = (v.x * derivs.row(c, 0)[x] + v.y * derivs.row(c, 1)[x]) >> kSteerShift;
         }
-        raw[static_cast<std::size_t>(c)] = d;
+      } else {
+        // Q1.14 coefficients of the mixed derivative; |cxx| + |cxy| + |cyy| <= 2^15.
+        const Vec& v = others[0];
+        const Vec& u = others[1];
+        const std::int32_t cxx = (v.x * u.x) >> kUnitShift;
+        const std::int32_t cyy = (v.y * u.y) >> kUnitShift;
+        const std::int32_t cxy = (v.x * u.y + v.y * u.x) >> kUnitShift;
+        for (std::size_t c = 0; c < 3; ++c) {
+          raw[c] =
+              (cxx * derivs.row(c, 2)[x] + cxy * derivs.row(c, 4)[x] + cyy * derivs.row(c, 3)[x]) >>
+              kSteerShift;
+        }
       }
       // Below the contrast floor (noise in shadows and on black) nothing is separated: the
       // division by a dark average would lift it over the relative threshold.
-      const std::int64_t hi = std::max({raw[0], raw[1], raw[2]});
-      const std::int64_t lo = std::min({raw[0], raw[1], raw[2]});
+      const std::int32_t hi = std::max({raw[0], raw[1], raw[2]});
+      const std::int32_t lo = std::min({raw[0], raw[1], raw[2]});
       for (std::size_t c = 0; c < 3; ++c) {
-        out[c][x] = hi - lo < minContrast
-                        ? std::int16_t{0}
-                        : saturate16((raw[c] * inverseColour[colourTile + c]) >> kNormShift);
+        out[c][x] =
+            hi - lo < minContrast
+                ? std::int16_t{0}
+                : saturate16((std::int64_t{raw[c]} * inverseColour[colourTile + c]) >> kNormShift);
       }
       orderRow[x] = otherCount < 2 ? 1 : 2;
     }

@@ -25,8 +25,7 @@ void copyChannel(ConstRgbView image, ImageView<std::int16_t> out, int scale) {
 
 // One [1 2 1]ᵀ[1 2 1] pass in place, edges repeated, result (sum + half) >> shift.
 // scratch holds 2 × width values.
-void binomialPass(ImageView<std::int16_t> plane, int shift, std::int16_t* prev,
-                  std::int16_t* cur) {
+void binomialPass(ImageView<std::int16_t> plane, int shift, std::int16_t* prev, std::int16_t* cur) {
   const int w = plane.width();
   const int h = plane.height();
   const std::int32_t half = shift > 0 ? 1 << (shift - 1) : 0;
@@ -143,7 +142,8 @@ void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& 
         if (average < kColourFloor) {
           average = kColourFloor;
         }
-        inverse[out + c] = static_cast<std::uint32_t>((std::uint64_t{1} << kInverseShift) / average);
+        inverse[out + c] =
+            static_cast<std::uint32_t>((std::uint64_t{1} << kInverseShift) / average);
       }
     }
   }

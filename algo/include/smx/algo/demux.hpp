@@ -110,10 +110,10 @@ class Demultiplexer {
   std::span<demux::TileInterp> columns_;
   std::span<demux::TileInterp> rows_;
   std::span<std::int16_t> rowScratch_;
+  std::span<std::int32_t> derivativeRows_;      // separate()'s row of derivatives
   std::span<std::int32_t> filterRows_;          // separate()'s ring of filtered rows
   std::span<std::uint32_t> tileHistograms_;     // tileCount × 64 bins
-  std::span<std::uint16_t> sampleAngles_;       // doubled angle per histogram sample, ×3 channels
-  std::span<std::uint16_t> sampleWeights_;      // weight per histogram sample (0: none)
+  std::span<std::int32_t> tileMoments_;         // tileCount × 64 first moments per bin
   std::span<std::uint32_t> tileColourSums_;     // tileCount × 3
   std::span<std::uint32_t> tileInverseColour_;  // tileCount × 3: 2^24 / average
   std::span<TileDirection> tileDirections_;     // projectors × tileCount
