@@ -16,39 +16,12 @@
 #include <vector>
 
 #include "boundary_eval.hpp"
+#include "demux_frame.hpp"
 #include "sim_frame.hpp"
 #include "smx/algo/demux.hpp"
-#include "smx/algo/encoding_prediction.hpp"
 
 namespace smx::algo {
 namespace {
-
-// Predictions are made for a surface at 0.75 m while the scenes stand at 0.9 m and beyond, so
-// the measured directions are the estimator's, not the calibration's.
-constexpr double kNominalDepthM = 0.75;
-
-struct Demuxed {
-  std::vector<std::byte> memory;
-  std::optional<Arena> arena;
-  std::optional<Demultiplexer> demux;
-};
-
-std::unique_ptr<Demuxed> runDemux(const test::SimFrame& f) {
-  auto out = std::make_unique<Demuxed>();
-  const DemuxLayout layout{
-      f.image.width, f.image.height, static_cast<int>(f.rig.projectors.size()), {}};
-  const auto bytes = Demultiplexer::workspaceBytes(layout);
-  EXPECT_TRUE(bytes.has_value());
-  out->memory.resize(bytes.value_or(0));
-  out->arena.emplace(out->memory);
-  const auto predicted = predictEncodingAngles(f.rig, 0, layout, kNominalDepthM);
-  EXPECT_TRUE(predicted.has_value()) << predicted.error();
-  auto demux = Demultiplexer::create(layout, predicted.value(), *out->arena);
-  EXPECT_TRUE(demux.has_value()) << demux.error().message;
-  out->demux.emplace(std::move(*demux));
-  EXPECT_TRUE(out->demux->run(f.image.view()).has_value());
-  return out;
-}
 
 struct Figures {
   test::BoundaryScore boundaries;
@@ -59,18 +32,7 @@ struct Figures {
 // 3 px inside that region and away from depth jumps over 2 %.
 Figures measure(const test::SimFrame& f, const Demultiplexer& d, int p, int patterns,
                 const std::string& label) {
-  std::vector<ImageView<const std::uint8_t>> lits;
-  for (const auto& lit : f.lit) {
-    lits.push_back(lit.view());
-  }
-  test::Mask region =
-      test::smoothOnly(test::erode(test::litByExactly(lits, patterns), 3), f.depth.view(), 0.02);
-  const auto& mine = f.lit[static_cast<std::size_t>(p)];
-  for (int y = 0; y < region.height; ++y) {
-    for (int x = 0; x < region.width; ++x) {
-      region.at(x, y) = (region.at(x, y) != 0 && mine.at(x, y) != 0) ? 255 : 0;
-    }
-  }
+  const test::Mask region = test::regionLitBy(f, p, patterns);
   Figures fig{test::scoreBoundaries(d.boundaries(p), d.directions(p),
                                     f.stripe[static_cast<std::size_t>(p)].view(), region.view()),
               test::scoreDirections(d.directions(p), f.stripe[static_cast<std::size_t>(p)].view(),
@@ -109,7 +71,7 @@ constexpr Limits kTwoPatternTargets{2.0, 5.0, 0.98, 0.98, 0.99, 0.15};
 // Given the flat board and two patterns 90° apart, every target holds for both projectors.
 TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
-  const auto d = runDemux(f);
+  const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 90deg"), kTwoPatternTargets,
                  "projector " + std::to_string(p));
@@ -121,7 +83,7 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
   auto rig = test::loadExampleRig("rig_2proj_1cam.json");
   rig.projectors[1].pattern.angleDeg = 70.0;
   const auto f = test::renderSimFrame(rig, test::loadNamedScene("plane"));
-  const auto d = runDemux(f);
+  const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 70deg"), kTwoPatternTargets,
                  "projector " + std::to_string(p));
@@ -134,7 +96,7 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 // boundaries are within a point of the targets (ratchet).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
-  const auto d = runDemux(f);
+  const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"),
                  {1.0, 15.0, 0.975, 0.985, 0.985, 0.16}, "projector " + std::to_string(p));
@@ -148,7 +110,7 @@ TEST(DemuxAccuracy, TwoPatternsOnASphere) {
 // three lobes are broad and overlap.
 TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
   const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
-  const auto d = runDemux(f);
+  const auto d = test::demultiplex(f);
   for (int p = 0; p < 3; ++p) {
     expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"),
                  {2.5, 13.0, 0.98, 0.99, 0.99, 0.22}, "projector " + std::to_string(p));
@@ -160,7 +122,7 @@ TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
 // (ratchet 0.21 px).
 TEST(DemuxAccuracy, TwoPatternsOnTheRgbcmyPanel) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
-  const auto d = runDemux(f);
+  const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "rgbcmy panel 90deg"),
                  {2.0, 5.0, 0.98, 0.98, 0.97, 0.21}, "projector " + std::to_string(p));

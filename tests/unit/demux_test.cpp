@@ -15,52 +15,16 @@
 #include "alloc_counter.hpp"
 #include "smx/algo/fixed_math.hpp"
 #include "smx/algo/stripe_code.hpp"
+#include "synthetic_stripes.hpp"
 
 namespace smx::algo {
 namespace {
 
 constexpr std::size_t kMiB = std::size_t{1} << 20;
 
-// Patterns as the projector shows them: stripe ⌊s⌋ of width stripePx along (cos a, sin a)
-// through the image centre, s = 99 there. Each pattern adds its primary at `level`.
-struct SyntheticPattern {
-  double angleDeg;
-  double stripePx;
-};
-
-double stripeAt(const SyntheticPattern& p, int w, int h, double x, double y) {
-  const double a = p.angleDeg * std::numbers::pi / 180.0;
-  return ((x - (w - 1) / 2.0) * std::cos(a) + (y - (h - 1) / 2.0) * std::sin(a)) / p.stripePx +
-         99.0;
-}
-
-std::vector<Rgb8> superpose(const std::vector<SyntheticPattern>& patterns, int w, int h,
-                            int level) {
-  std::vector<Rgb8> image(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  // 4 × 4 samples per pixel: the camera integrates over its pixel.
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      double acc[3] = {0, 0, 0};
-      for (int sy = 0; sy < 4; ++sy) {
-        for (int sx = 0; sx < 4; ++sx) {
-          for (const auto& p : patterns) {
-            const double s = stripeAt(p, w, h, x - 0.375 + sx * 0.25, y - 0.375 + sy * 0.25);
-            const int k = static_cast<int>(std::floor(s));
-            if (k >= 0 && k < stripe::kStripes) {
-              acc[stripe::indexOf(stripe::kSequence[static_cast<std::size_t>(k)])] += level / 16.0;
-            }
-          }
-        }
-      }
-      auto& px = image[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-                       static_cast<std::size_t>(x)];
-      px = {static_cast<std::uint8_t>(std::lround(acc[0] + 10)),
-            static_cast<std::uint8_t>(std::lround(acc[1] + 10)),
-            static_cast<std::uint8_t>(std::lround(acc[2] + 10))};
-    }
-  }
-  return image;
-}
+using test::stripeAt;
+using test::superpose;
+using test::SyntheticPattern;
 
 // Predicted angles: the exact encoding directions, the same in every tile.
 std::vector<std::uint16_t> exactPrediction(const DemuxLayout& layout,
@@ -141,7 +105,7 @@ TEST_P(DemuxSynthetic, BoundariesAreWhereThePatternsPutThemWithoutHeapUse) {
   const auto& patterns = GetParam();
   constexpr int kW = 160;
   constexpr int kH = 120;
-  const auto image = superpose(patterns, kW, kH, 110);
+  const auto image = superpose(patterns, kW, kH);
   const DemuxLayout layout{kW, kH, static_cast<int>(patterns.size()), {}};
   std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
   Arena arena(memory);

@@ -18,67 +18,14 @@
 #include <vector>
 
 #include "boundary_eval.hpp"
+#include "demux_frame.hpp"
 #include "sim_frame.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/direct_colour.hpp"
-#include "smx/algo/encoding_prediction.hpp"
 #include "smx/sim/renderer.hpp"
 
 namespace smx::algo {
 namespace {
-
-// As in demux_accuracy_test: predictions at 0.75 m, scenes at 0.9 m and beyond.
-constexpr double kNominalDepthM = 0.75;
-
-struct Demuxed {
-  std::vector<std::byte> memory;
-  std::unique_ptr<Arena> arena;
-  std::unique_ptr<Demultiplexer> demux;  // null when a step failed (reported as a failure)
-};
-
-std::unique_ptr<Demuxed> runDemux(const test::SimFrame& f) {
-  auto out = std::make_unique<Demuxed>();
-  const DemuxLayout layout{
-      f.image.width, f.image.height, static_cast<int>(f.rig.projectors.size()), {}};
-  const auto bytes = Demultiplexer::workspaceBytes(layout);
-  const auto predicted = predictEncodingAngles(f.rig, 0, layout, kNominalDepthM);
-  if (!bytes || !predicted) {
-    ADD_FAILURE() << "demux layout or encoding prediction failed";
-    return out;
-  }
-  out->memory.resize(*bytes);
-  out->arena = std::make_unique<Arena>(out->memory);
-  auto demux = Demultiplexer::create(layout, *predicted, *out->arena);
-  if (!demux) {
-    ADD_FAILURE() << demux.error().message;
-    return out;
-  }
-  out->demux = std::make_unique<Demultiplexer>(*demux);
-  if (!out->demux->run(f.image.view())) {
-    ADD_FAILURE() << "demux run failed";
-    out->demux.reset();
-  }
-  return out;
-}
-
-// Where exactly `patterns` projectors light the surface, p among them, 3 px inside that region
-// and away from depth jumps over 2 % (demux_accuracy_test's construction).
-test::Mask regionOf(const test::SimFrame& f, int p, int patterns) {
-  std::vector<ImageView<const std::uint8_t>> lits;
-  lits.reserve(f.lit.size());
-  for (const auto& lit : f.lit) {
-    lits.push_back(lit.view());
-  }
-  test::Mask region =
-      test::smoothOnly(test::erode(test::litByExactly(lits, patterns), 3), f.depth.view(), 0.02);
-  const auto& mine = f.lit[static_cast<std::size_t>(p)];
-  for (int y = 0; y < region.height; ++y) {
-    for (int x = 0; x < region.width; ++x) {
-      region.at(x, y) = (region.at(x, y) != 0 && mine.at(x, y) != 0) ? 255 : 0;
-    }
-  }
-  return region;
-}
 
 struct Comparison {
   int regionPx = 0;
@@ -95,7 +42,7 @@ struct Comparison {
 // Projector p's boundaries by both methods, scored in one region.
 Comparison compare(const test::SimFrame& f, const Demultiplexer& d, int p, int patterns,
                    const std::string& label) {
-  const test::Mask region = regionOf(f, p, patterns);
+  const test::Mask region = test::regionLitBy(f, p, patterns);
   test::OwnedPlane<Boundary> baseline(f.image.width, f.image.height, Boundary{});
   const auto ok = directColourBoundaries(f.image.view(), d.directions(p), baseline.view());
   EXPECT_TRUE(ok.has_value()) << ok.error().message;
@@ -245,8 +192,7 @@ void expectNeitherProjectorIsRead(const PixelReading& r, double minEitherShare,
 
 TEST(DirectColourAccuracy, OnAPlaneItFailsWhereTwoPatternsOverlap) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
-  const auto d = runDemux(f);
-  ASSERT_NE(d->demux, nullptr);
+  const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "plane"), 0.9, "plane");
   for (int p = 0; p < 2; ++p) {
     const std::string what = "plane, projector " + std::to_string(p);
@@ -258,8 +204,7 @@ TEST(DirectColourAccuracy, OnAPlaneItFailsWhereTwoPatternsOverlap) {
 
 TEST(DirectColourAccuracy, OnASphereItWorksAloneAndFailsWhereTwoPatternsOverlap) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
-  const auto d = runDemux(f);
-  ASSERT_NE(d->demux, nullptr);
+  const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "sphere"), 0.9, "sphere");
   for (int p = 0; p < 2; ++p) {
     const std::string what = "sphere, projector " + std::to_string(p);
@@ -272,8 +217,7 @@ TEST(DirectColourAccuracy, OnASphereItWorksAloneAndFailsWhereTwoPatternsOverlap)
 // dark or too unsaturated to classify at all (the lit-by-1 control lies on the grey wall).
 TEST(DirectColourAccuracy, OnTheRgbcmyPanelItFailsWhereTwoPatternsOverlap) {
   const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
-  const auto d = runDemux(f);
-  ASSERT_NE(d->demux, nullptr);
+  const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "rgbcmy_panel"), 0.75, "rgbcmy_panel");
   for (int p = 0; p < 2; ++p) {
     const std::string what = "rgbcmy panel, projector " + std::to_string(p);

@@ -18,6 +18,7 @@
 #include "alloc_counter.hpp"
 #include "smx/algo/fixed_math.hpp"
 #include "smx/algo/stripe_code.hpp"
+#include "synthetic_stripes.hpp"
 
 namespace smx::algo {
 namespace {
@@ -70,46 +71,9 @@ TEST(DirectColourClassify, DarkAndUnsaturatedColoursAreNone) {
   EXPECT_FALSE(classifyColour({255, 1, 1}, {0, 1000}).present);
 }
 
-// A pattern as a projector shows it: stripe ⌊s⌋ of width stripePx along (cos a, sin a) through
-// the image centre, s = 99 there; it adds `level` to its colour's channel. Each pixel averages
-// 4 × 4 samples.
-struct SyntheticPattern {
-  double angleDeg;
-  double stripePx;
-  double level;
-};
-
-double stripeAt(const SyntheticPattern& p, int w, int h, double x, double y) {
-  const double a = p.angleDeg * std::numbers::pi / 180.0;
-  return ((x - (w - 1) / 2.0) * std::cos(a) + (y - (h - 1) / 2.0) * std::sin(a)) / p.stripePx +
-         99.0;
-}
-
-std::vector<Rgb8> superpose(const std::vector<SyntheticPattern>& patterns, int w, int h) {
-  std::vector<Rgb8> image(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      double acc[3] = {10, 10, 10};  // ambient
-      for (int sy = 0; sy < 4; ++sy) {
-        for (int sx = 0; sx < 4; ++sx) {
-          for (const auto& p : patterns) {
-            const double s = stripeAt(p, w, h, x - 0.375 + sx * 0.25, y - 0.375 + sy * 0.25);
-            const int k = static_cast<int>(std::floor(s));
-            if (k >= 0 && k < stripe::kStripes) {
-              acc[stripe::indexOf(stripe::kSequence[static_cast<std::size_t>(k)])] +=
-                  p.level / 16.0;
-            }
-          }
-        }
-      }
-      image[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-            static_cast<std::size_t>(x)] = {static_cast<std::uint8_t>(std::lround(acc[0])),
-                                            static_cast<std::uint8_t>(std::lround(acc[1])),
-                                            static_cast<std::uint8_t>(std::lround(acc[2]))};
-    }
-  }
-  return image;
-}
+using test::stripeAt;
+using test::superpose;
+using test::SyntheticPattern;
 
 struct Found {
   int boundaries = 0;  // detections
