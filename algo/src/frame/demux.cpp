@@ -91,6 +91,7 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(take(carver, tileColourSums_, tiles * 3));
   step(take(carver, tileInverseColour_, tiles * 3));
   step(take(carver, tileDirections_, tiles * projectors));
+  step(take(carver, tileScratch_, tiles));
   for (auto& plane : smoothed_) {
     step(takeImage(carver, plane, l));
   }
@@ -153,7 +154,8 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
   demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
-  demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_);
+  demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                            tileScratch_);
   demux::interpolateDirections(
       layout_, tileDirections_, columns_, rows_,
       std::span<const DirectionPlane>(directions_.data(),

@@ -84,6 +84,30 @@ Boundary classify(const Response& r, std::int32_t offsetQ8) {
   return b;
 }
 
+// Second order: the boundary is where the second derivative, read as (to − from) channel,
+// crosses zero from + to − along the direction; linear between the samples at −1, 0, +1 px.
+// Falls back to `fallback` when it does not cross there.
+std::int32_t zeroCrossingQ8(const Planes3& separated, const Boundary& b, int x, int y,
+                            std::int32_t ux, std::int32_t uy, std::int32_t fallback) {
+  const auto to = static_cast<std::size_t>(stripe::indexOf(stripe::to(b.kind())));
+  const auto from = static_cast<std::size_t>(stripe::indexOf(stripe::from(b.kind())));
+  const std::int32_t xq = x * 256;
+  const std::int32_t yq = y * 256;
+  const auto v = [&](std::int32_t sx, std::int32_t sy) {
+    return sampleQ8(separated[to], sx, sy) - sampleQ8(separated[from], sx, sy);
+  };
+  const std::int32_t before = v(xq - (ux >> 6), yq - (uy >> 6));
+  const std::int32_t here = v(xq, yq);
+  const std::int32_t after = v(xq + (ux >> 6), yq + (uy >> 6));
+  if (here >= 0 && after < 0) {
+    return (256 * here) / (here - after);
+  }
+  if (before > 0 && here < 0) {
+    return -256 + (256 * before) / (before - here);
+  }
+  return fallback;
+}
+
 }  // namespace
 
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
@@ -140,8 +164,13 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
       }
       const std::int32_t den = ahead + behind - 2 * s0;  // < 0 at a strict maximum
       std::int32_t offset = den < 0 ? (128 * (behind - ahead)) / den : 0;
-      offset = offset > 128 ? 128 : (offset < -128 ? -128 : offset);
-      b[x] = classify(responseAt(separated, o[x], x, y, ux, uy), offset);
+      Boundary found = classify(responseAt(separated, o[x], x, y, ux, uy), 0);
+      if (o[x] == 2) {
+        offset = zeroCrossingQ8(separated, found, x, y, ux, uy, offset);
+      }
+      found.offset =
+          static_cast<std::int16_t>(offset > 128 ? 128 : (offset < -128 ? -128 : offset));
+      b[x] = found;
     }
   }
 }

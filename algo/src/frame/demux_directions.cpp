@@ -69,6 +69,56 @@ Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
 // Presence stays 0.
 constexpr int kFillRadius = 2;
 
+// Tile estimates scatter by a few degrees where lobes are broad (three patterns) and single tiles
+// go astray; the field itself varies slowly. Each found tile takes the median offset from the
+// prediction over the found tiles of its 3×3 neighbourhood.
+void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+                       std::span<TileDirection> out, std::span<std::uint16_t> scratch) {
+  const int tilesX = layout.tilesX();
+  const int tilesY = layout.tilesY();
+  const std::size_t tileCount = layout.tileCount();
+  const auto projectors = static_cast<std::size_t>(layout.projectors);
+  for (std::size_t p = 0; p < projectors; ++p) {
+    const std::span<TileDirection> tiles = out.subspan(p * tileCount, tileCount);
+    for (int ty = 0; ty < tilesY; ++ty) {
+      for (int tx = 0; tx < tilesX; ++tx) {
+        const auto t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
+                       static_cast<std::size_t>(tx);
+        scratch[t] = tiles[t].angle;
+        if (tiles[t].present == 0) {
+          continue;
+        }
+        std::int32_t offsets[9];
+        int count = 0;
+        for (int j = ty - 1; j <= ty + 1; ++j) {
+          for (int i = tx - 1; i <= tx + 1; ++i) {
+            if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
+              continue;
+            }
+            const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
+                           static_cast<std::size_t>(i);
+            if (tiles[n].present == 0) {
+              continue;
+            }
+            // Insertion into the sorted prefix.
+            const std::int32_t value = wrapDiff(tiles[n].angle, predicted[n * projectors + p]);
+            int k = count++;
+            for (; k > 0 && offsets[k - 1] > value; --k) {
+              offsets[k] = offsets[k - 1];
+            }
+            offsets[k] = value;
+          }
+        }
+        scratch[t] = static_cast<std::uint16_t>(predicted[t * projectors + p] +
+                                                static_cast<std::uint16_t>(offsets[count / 2]));
+      }
+    }
+    for (std::size_t t = 0; t < tileCount; ++t) {
+      tiles[t].angle = scratch[t];
+    }
+  }
+}
+
 void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
                      std::span<TileDirection> out) {
   const int tilesX = layout.tilesX();
@@ -171,7 +221,8 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
 
 void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
                         std::span<const std::int32_t> tileMoments,
-                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out) {
+                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                        std::span<std::uint16_t> scratch) {
   const int tilesX = layout.tilesX();
   const int tilesY = layout.tilesY();
   const int r = layout.params.windowTiles / 2;
@@ -313,6 +364,9 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       }
     }
   }
+  // Twice: the second pass removes what clusters of stray tiles leave after the first.
+  medianFilterTiles(layout, predicted, out, scratch);
+  medianFilterTiles(layout, predicted, out, scratch);
   fillAbsentTiles(layout, predicted, out);
 }
 

@@ -73,11 +73,13 @@ struct SampleGrid {
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
                     std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments);
 
-// Stage 2b: lobes of each tile's window histogram matched to the predicted directions.
-// out[p * tileCount + t].
+// Stage 2b: lobes of each tile's window histogram matched to the predicted directions, then a
+// 3×3 median of the found tiles' offsets from the prediction; tiles without the lobe take their
+// neighbours'. out[p * tileCount + t]; scratch holds tileCount values.
 void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
                         std::span<const std::int32_t> tileMoments,
-                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out);
+                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                        std::span<std::uint16_t> scratch);
 
 // Bilinear interpolation between tile centres (tile i's centre is pixel i·T + (T−1)/2), per
 // column or row: the lower tile, the upper one, the upper one's weight in 1/256 and the

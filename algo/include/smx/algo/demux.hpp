@@ -116,6 +116,7 @@ class Demultiplexer {
   std::span<std::int32_t> tileMoments_;         // tileCount × 64 first moments per bin
   std::span<std::uint32_t> tileColourSums_;     // tileCount × 3
   std::span<std::uint32_t> tileInverseColour_;  // tileCount × 3: 2^24 / average
+  std::span<std::uint16_t> tileScratch_;        // tileCount: the direction median filter's
   std::span<TileDirection> tileDirections_;     // projectors × tileCount
   std::array<ImageView<std::int16_t>, 3> smoothed_;
   std::array<ImageView<std::int16_t>, 3> separated_;
