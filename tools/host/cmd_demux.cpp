@@ -51,8 +51,13 @@ std::expected<std::vector<CameraImage>, std::string> parseImages(
       known += (known.empty() ? "" : ", ") + rig.cameras[c].id;
     }
     if (!index) {
-      return std::unexpected("--image " + spec + ": the rig has no camera \"" + id +
-                             "\" (cameras: " + known + ")");
+      std::string message = "--image " + spec;
+      message += ": the rig has no camera \"";
+      message += id;
+      message += "\" (cameras: ";
+      message += known;
+      message += ")";
+      return std::unexpected(message);
     }
     out.push_back({*index, spec.substr(eq + 1)});
   }
