@@ -5,15 +5,16 @@
 //   bias the orientation of oblique stripes by degrees), its doubled angle (atan2 then ×2,
 //   BinAngle) and weight |g| (isqrt of gx² + gy² in uint32); gradients below minGradientGrey
 //   count nothing.
-//   Per tile: a 64-bin histogram of the samples' doubled angles, weighted.
 //   Per tile: a 64-bin histogram of the samples' doubled angles, weighted, and per bin the first
 //   moment Σ w·(angle − bin centre) (int32: (tilePx / stride)² · 3 samples of weight < 2^14 and
 //   offset ≤ 2^9 stay below 2^31 for the allowed (tilePx / stride)² ≤ 64).
 //   Per tile window (windowTiles² tiles, sums in 64 bits): lobes are maxima of π/2-wide angle
 //   windows stepped by π/4 that are not at a window edge; each is refined by two mean-shift
 //   steps on the histogram (exact weighted mean of the samples in the bins within ±2 of the
-//   centre) and matched to the nearest predicted axis; the doubled angle is halved and its sign
-//   taken from the prediction.
+//   centre) and matched to the nearest predicted axis (within the tolerance and half the angle to
+//   the nearest other axis, holding the minimum share); the doubled angle is halved and its sign
+//   taken from the prediction. Then a 3×3 median (twice) of the offsets from the prediction, and
+//   tiles without the lobe take their neighbours' offset.
 #include <cstdint>
 
 #include "demux_kernels.hpp"

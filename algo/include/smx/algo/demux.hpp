@@ -18,13 +18,15 @@
 //   1. binomial smoothing of each channel (×16 fixed point);
 //   2. per tile, the magnitude-weighted histogram of doubled gradient angles over a window of
 //      tiles; its lobes, refined by a local weighted mean, are matched to each projector's
-//      predicted encoding direction (sign and identity come from the rig);
+//      predicted encoding direction (sign and identity come from the rig); a median over
+//      neighbouring tiles removes strays;
 //   3. per pixel, the directional derivative that cancels the other patterns present: along
 //      the projector's own axis (alone), perpendicular to the other axis (two patterns), or the
 //      mixed second derivative perpendicular to both others (three patterns);
 //   4. division by the locally averaged colour;
-//   5. non-maximum suppression along the encoding axis, sub-pixel position by a parabola, the
-//      transition class (from the falling and the rising channel) and a confidence.
+//   5. non-maximum suppression along the encoding axis, sub-pixel position (parabola, or the
+//      second derivative's zero crossing), the transition class (from the falling and the
+//      rising channel) and a confidence.
 namespace smx::algo {
 
 inline constexpr int kMaxProjectors = 3;
@@ -36,6 +38,7 @@ struct DemuxParams {
   int histogramStride = 2;       // gradients sampled every n-th pixel in x and y for the histogram
   int minGradientGrey = 4;       // gradient magnitude (grey levels per pixel) counted in histograms
   int lobeToleranceDeg = 30;     // a lobe is a projector's if within this of its predicted axis
+                                 // (and within half the angle to the nearest other axis)
   int minLobeSharePct = 8;       // and holds at least this share of the window's weight
   int minStrengthPermille = 80;  // boundary strength, relative to the local average colour
   int minContrastGrey = 4;       // and in grey levels per pixel (max − min over the channels)
