@@ -8,6 +8,7 @@
 //   sub-pixel offset is the vertex of the parabola through the three samples (±½ px, Q8).
 //   Class: the rising channel is the colour after the boundary, the falling one the colour
 //   before. Confidence 255 · (1 − |2·n_third − n_to − n_from| / (n_to − n_from)).
+#include <algorithm>
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -119,16 +120,37 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
 
   for (int y = 0; y < h; ++y) {
     std::uint16_t* s = strength.rowPtr(y);
+    for (int x = 0; x < w; ++x) {
+      s[x] = 0;
+    }
+    if (y < kMargin || y >= h - kMargin) {
+      continue;
+    }
     const std::uint8_t* o = order.rowPtr(y);
     const std::uint16_t* d = direction.rowPtr(y);
-    for (int x = 0; x < w; ++x) {
-      if (y < kMargin || y >= h - kMargin || x < kMargin || x >= w - kMargin || o[x] == 0) {
-        s[x] = 0;
-        continue;
+    const std::int16_t* v0 = separated[0].rowPtr(y);
+    const std::int16_t* v1 = separated[1].rowPtr(y);
+    const std::int16_t* v2 = separated[2].rowPtr(y);
+    // First-order pixels (most): max − min of the three planes, a branch-free loop; the
+    // second-order ones are then redone with their bilinear responses.
+    bool anySecond = false;
+    for (int x = kMargin; x < w - kMargin; ++x) {
+      const std::int32_t hi =
+          std::max({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
+      const std::int32_t lo =
+          std::min({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
+      s[x] = o[x] == 1 ? static_cast<std::uint16_t>(hi - lo > 65535 ? 65535 : hi - lo) : 0;
+      anySecond = anySecond || o[x] == 2;
+    }
+    if (!anySecond) {
+      continue;
+    }
+    for (int x = kMargin; x < w - kMargin; ++x) {
+      if (o[x] == 2) {
+        const std::int32_t v =
+            strengthOf(responseAt(separated, 2, x, y, units.cosOf(d[x]), units.sinOf(d[x])));
+        s[x] = static_cast<std::uint16_t>(v > 65535 ? 65535 : v);
       }
-      const Response r = responseAt(separated, o[x], x, y, units.cosOf(d[x]), units.sinOf(d[x]));
-      const std::int32_t v = strengthOf(r);
-      s[x] = static_cast<std::uint16_t>(v > 65535 ? 65535 : v);
     }
   }
 

@@ -88,6 +88,40 @@ void filterRow(const std::int16_t* s, int w, std::int32_t* pre, std::int32_t* d1
   }
 }
 
+// The vertical halves over rows y − 2 … y + 2 for a whole row, scaled by 2^-kRowShift (the rows
+// and the output never overlap: restrict lets the loops vectorise).
+constexpr int kRowShift = 13;
+
+void verticalSmoothed(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+  const std::int32_t* __restrict r0 = rows[0];
+  const std::int32_t* __restrict r1 = rows[1];
+  const std::int32_t* __restrict r2 = rows[2];
+  const std::int32_t* __restrict r3 = rows[3];
+  const std::int32_t* __restrict r4 = rows[4];
+  for (int x = 2; x + 2 < w; ++x) {
+    out[x] = (kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x]) >> kRowShift;
+  }
+}
+
+void verticalDerivative(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+  const std::int32_t* __restrict r0 = rows[0];
+  const std::int32_t* __restrict r1 = rows[1];
+  const std::int32_t* __restrict r3 = rows[3];
+  const std::int32_t* __restrict r4 = rows[4];
+  for (int x = 2; x + 2 < w; ++x) {
+    out[x] = (kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x])) >> kRowShift;
+  }
+}
+
+void verticalSecond(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+  const std::int32_t* __restrict r0 = rows[0];
+  const std::int32_t* __restrict r2 = rows[2];
+  const std::int32_t* __restrict r4 = rows[4];
+  for (int x = 2; x + 2 < w; ++x) {
+    out[x] = (kD2[0] * (r0[x] + r4[x]) + kD2[2] * r2[x]) >> kRowShift;
+  }
+}
+
 }  // namespace
 
 FilterRows::FilterRows(std::span<std::int32_t> memory, int width)
@@ -165,10 +199,11 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
   constexpr int kNormShift = kInverseShift - kRelativeShift;
   // Row derivatives keep 2^-13 of the filter output (|value| < 2^16); steering by Q1.14
   // coefficients then shifts by 14 + 2 to reach D = 2·∂S (the filters' unit is 2^15 · 2·∂S).
-  constexpr int kRowShift = 13;
   constexpr int kSteerShift = kUnitShift + kDerivShift - kRowShift;
   // D is 2·∂S = 32 × grey level per pixel.
   const std::int32_t minContrast = layout.params.minContrastGrey * 2 * kSmoothScale;
+  // Tile columns are at most 8192 / 4.
+  std::uint8_t presentBits[2048] = {};
   // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
   const auto slotOf = [](int row) { return (row + FilterRows::kSlots) % FilterRows::kSlots; };
   const auto fill = [&](int row) {
@@ -194,59 +229,51 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
     }
     const TileInterp& ry = rows[static_cast<std::size_t>(y)];
     const bool borderRow = y < 2 || y + 2 >= h;
+    // Which projectors the nearest tile found, per tile column of this row.
+    for (int tx = 0; tx < tilesX; ++tx) {
+      unsigned bits = 0;
+      for (int p = 0; p < projectors; ++p) {
+        bits |= tileAt(p, tx, ry.nearest).present != 0 ? 1U << p : 0U;
+      }
+      presentBits[tx] = static_cast<std::uint8_t>(bits);
+    }
     // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel, for the
     // whole row (int32, vectorisable), scaled by 2^-13 into int32 range for the steering.
     const bool second = projectors == kMaxProjectors;
     for (std::size_t c = 0; c < 3; ++c) {
-      const std::int32_t* pre[5];
-      const std::int32_t* d1[5];
-      const std::int32_t* d2[5];
+      const std::int32_t* pre[5] = {};
+      const std::int32_t* d1[5] = {};
+      const std::int32_t* d2[5] = {};
       for (int k = 0; k < 5; ++k) {
         const int slot = slotOf(y + k - 2);
         pre[k] = filtered.row(slot, static_cast<int>(c), 0);
         d1[k] = filtered.row(slot, static_cast<int>(c), 1);
         d2[k] = filtered.row(slot, static_cast<int>(c), 2);
       }
-      std::int32_t* gx = derivs.row(c, 0);
-      std::int32_t* gy = derivs.row(c, 1);
-      for (int x = 2; x + 2 < w; ++x) {
-        gx[x] = (kPre[0] * (d1[0][x] + d1[4][x]) + kPre[1] * (d1[1][x] + d1[3][x]) +
-                 kPre[2] * d1[2][x]) >>
-                kRowShift;
-        gy[x] = (kD1[3] * (pre[3][x] - pre[1][x]) + kD1[4] * (pre[4][x] - pre[0][x])) >> kRowShift;
-      }
+      verticalSmoothed(d1, derivs.row(c, 0), w);
+      verticalDerivative(pre, derivs.row(c, 1), w);
       if (second) {
-        std::int32_t* hxx = derivs.row(c, 2);
-        std::int32_t* hyy = derivs.row(c, 3);
-        std::int32_t* hxy = derivs.row(c, 4);
-        for (int x = 2; x + 2 < w; ++x) {
-          hxx[x] = (kPre[0] * (d2[0][x] + d2[4][x]) + kPre[1] * (d2[1][x] + d2[3][x]) +
-                    kPre[2] * d2[2][x]) >>
-                   kRowShift;
-          hyy[x] = (kD2[0] * (pre[0][x] + pre[4][x]) + kD2[2] * pre[2][x]) >> kRowShift;
-          hxy[x] = (kD1[3] * (d1[3][x] - d1[1][x]) + kD1[4] * (d1[4][x] - d1[0][x])) >> kRowShift;
-        }
+        verticalSmoothed(d2, derivs.row(c, 2), w);
+        verticalSecond(pre, derivs.row(c, 3), w);
+        verticalDerivative(d1, derivs.row(c, 4), w);
       }
     }
     for (int x = 0; x < w; ++x) {
       const TileInterp& cx = columns[static_cast<std::size_t>(x)];
-      std::uint16_t angle[kMaxProjectors] = {0, 0, 0};
-      bool present[kMaxProjectors] = {false, false, false};
-      for (int p = 0; p < projectors; ++p) {
-        angle[p] = dirRows[p][x];
-        present[p] = tileAt(p, cx.nearest, ry.nearest).present != 0;
-      }
       if (borderRow || x < 2 || x + 2 >= w) {
         out[0][x] = out[1][x] = out[2][x] = 0;
         orderRow[x] = 0;
         continue;
       }
-      const Vec own{units.cosOf(angle[projector]), units.sinOf(angle[projector])};
+      const std::uint16_t ownAngle = dirRows[projector][x];
+      const Vec own{units.cosOf(ownAngle), units.sinOf(ownAngle)};
       Vec others[2] = {{0, 0}, {0, 0}};
       int otherCount = 0;
+      const unsigned presentHere = presentBits[cx.nearest];
       for (int q = 0; q < projectors; ++q) {
-        if (q != projector && present[q]) {
-          others[otherCount++] = normalTowards({units.cosOf(angle[q]), units.sinOf(angle[q])}, own);
+        if (q != projector && (presentHere & (1U << q)) != 0) {
+          const std::uint16_t a = dirRows[q][x];
+          others[otherCount++] = normalTowards({units.cosOf(a), units.sinOf(a)}, own);
         }
       }
       const std::size_t colourTile =
