@@ -136,13 +136,12 @@ class Stages {
         tileScratch_(layout.tileCount()),
         columns_(static_cast<std::size_t>(w_)),
         rows_(static_cast<std::size_t>(h_)),
-        filterMemory_(kern::FilterRows::valuesFor(w_)),
+        filterMemory_(kern::RowBlock::valuesFor(kern::kFilterRows, w_)),
         filterRows_(filterMemory_, w_),
-        derivativeMemory_(kern::DerivativeRows::valuesFor(w_)),
+        derivativeMemory_(kern::RowBlock::valuesFor(kern::kDerivativeRows, w_)),
         derivativeRows_(derivativeMemory_, w_),
         strength_(pixelsOf(w_, h_)),
-        // As Demultiplexer::separateOnly(): Q4.11 threshold from per mille.
-        minStrength_((layout.params.minStrengthPermille << kern::kRelativeShift) / 1000) {
+        minStrength_(kern::minStrengthQ11(layout.params)) {
     units_.fill();
     kern::tileInterpolation(w_, layout.params.tilePx, layout.tilesX(), columns_);
     kern::tileInterpolation(h_, layout.params.tilePx, layout.tilesY(), rows_);
@@ -236,9 +235,9 @@ class Stages {
   std::vector<kern::TileInterp> rows_;
   kern::UnitTable units_;
   std::vector<std::int32_t> filterMemory_;
-  kern::FilterRows filterRows_;
+  kern::RowBlock filterRows_;
   std::vector<std::int32_t> derivativeMemory_;
-  kern::DerivativeRows derivativeRows_;
+  kern::RowBlock derivativeRows_;
   std::vector<std::uint16_t> strength_;
   std::vector<ProjectorOut> projectors_;
   std::array<algo::DirectionPlane, algo::kMaxProjectors> directionPlanes_{};

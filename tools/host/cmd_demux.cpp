@@ -68,7 +68,7 @@ std::expected<void, std::string> writeDebug(const fs::path& dir, const std::stri
                                             const algo::Demultiplexer& demux, int projector) {
   const algo::ImageView<const std::int16_t> separated[3] = {demux.separated(0), demux.separated(1),
                                                             demux.separated(2)};
-  const std::pair<const char*, RgbBuffer> images[] = {
+  const std::pair<const char*, sim::RgbImage> images[] = {
       {".boundaries.png", renderBoundaries(demux.boundaries(projector))},
       {".separated.png", renderSeparated(separated)},
       {".direction.png",

@@ -8,7 +8,7 @@ namespace smx::host {
 
 namespace {
 
-RgbBuffer blank(int width, int height) {
+sim::RgbImage blank(int width, int height) {
   return {
       width, height,
       std::vector<algo::Rgb8>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
@@ -21,8 +21,8 @@ std::uint8_t clip(double v) {
 
 }  // namespace
 
-RgbBuffer renderBoundaries(algo::ConstBoundaryPlane boundaries) {
-  RgbBuffer out = blank(boundaries.width(), boundaries.height());
+sim::RgbImage renderBoundaries(algo::ConstBoundaryPlane boundaries) {
+  sim::RgbImage out = blank(boundaries.width(), boundaries.height());
   for (int y = 0; y < boundaries.height(); ++y) {
     for (int x = 0; x < boundaries.width(); ++x) {
       const algo::Boundary b = boundaries(x, y);
@@ -49,10 +49,10 @@ RgbBuffer renderBoundaries(algo::ConstBoundaryPlane boundaries) {
   return out;
 }
 
-RgbBuffer renderSeparated(const algo::ImageView<const std::int16_t> (&channels)[3]) {
+sim::RgbImage renderSeparated(const algo::ImageView<const std::int16_t> (&channels)[3]) {
   const int w = channels[0].width();
   const int h = channels[0].height();
-  RgbBuffer out = blank(w, h);
+  sim::RgbImage out = blank(w, h);
   // Q4.11: ±1 (a step of the local average colour per pixel) spans ±127 grey levels.
   constexpr double kGain = 127.0 / 2048.0;
   for (int y = 0; y < h; ++y) {
@@ -66,11 +66,11 @@ RgbBuffer renderSeparated(const algo::ImageView<const std::int16_t> (&channels)[
   return out;
 }
 
-RgbBuffer renderDirections(algo::ConstDirectionPlane directions,
-                           algo::ConstBoundaryPlane boundaries) {
+sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
+                               algo::ConstBoundaryPlane boundaries) {
   const int w = directions.width();
   const int h = directions.height();
-  RgbBuffer out = blank(w, h);
+  sim::RgbImage out = blank(w, h);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       bool near = false;

@@ -1,34 +1,25 @@
 #pragma once
 
-#include <vector>
-
 #include "smx/algo/boundary_map.hpp"
 #include "smx/algo/image_view.hpp"
+#include "smx/sim/png_io.hpp"
 
 // Debug renderings of orientation demultiplexing, like the paper's stripe-segmented images
 // (Fig. 9(b, c), 11(c–e)): what a person looks at to see whether separation worked.
 namespace smx::host {
 
-struct RgbBuffer {
-  int width = 0;
-  int height = 0;
-  std::vector<algo::Rgb8> pixels;
-  [[nodiscard]] algo::ConstRgbView view() const {
-    return *algo::ConstRgbView::packed(pixels, width, height);
-  }
-};
-
 // Black, with each boundary pixel in the colour after the boundary (the paper's grouping R, G, B),
 // brighter with more confidence.
-[[nodiscard]] RgbBuffer renderBoundaries(algo::ConstBoundaryPlane boundaries);
+[[nodiscard]] sim::RgbImage renderBoundaries(algo::ConstBoundaryPlane boundaries);
 
 // A separated, colour-normalised derivative (Q4.11 per channel) as grey 128 + gain · value per
 // channel, clipped: rising channels bright, falling ones dark (paper Fig. 8, bottom).
-[[nodiscard]] RgbBuffer renderSeparated(const algo::ImageView<const std::int16_t> (&channels)[3]);
+[[nodiscard]] sim::RgbImage renderSeparated(
+    const algo::ImageView<const std::int16_t> (&channels)[3]);
 
 // The encoding direction as a hue (0° red, 120° green, 240° blue), where the projector has a
 // boundary within the pixel's 3×3 neighbourhood brighter.
-[[nodiscard]] RgbBuffer renderDirections(algo::ConstDirectionPlane directions,
-                                         algo::ConstBoundaryPlane boundaries);
+[[nodiscard]] sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
+                                             algo::ConstBoundaryPlane boundaries);
 
 }  // namespace smx::host

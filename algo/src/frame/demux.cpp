@@ -84,8 +84,8 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(take(carver, columns_, static_cast<std::size_t>(l.width)));
   step(take(carver, rows_, static_cast<std::size_t>(l.height)));
   step(take(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
-  step(take(carver, filterRows_, demux::FilterRows::valuesFor(l.width)));
-  step(take(carver, derivativeRows_, demux::DerivativeRows::valuesFor(l.width)));
+  step(take(carver, filterRows_, demux::RowBlock::valuesFor(demux::kFilterRows, l.width)));
+  step(take(carver, derivativeRows_, demux::RowBlock::valuesFor(demux::kDerivativeRows, l.width)));
   step(take(carver, tileHistograms_, tiles * demux::kBins));
   step(take(carver, tileMoments_, tiles * demux::kBins));
   step(take(carver, tileColourSums_, tiles * 3));
@@ -173,17 +173,15 @@ Result<void> Demultiplexer::separateOnly(int projector) {
     return fail(Errc::kInvalidArgument, "demux: no such projector");
   }
   const auto p = static_cast<std::size_t>(projector);
-  const demux::FilterRows filtered(filterRows_, layout_.width);
-  const demux::DerivativeRows derivs(derivativeRows_, layout_.width);
+  const demux::RowBlock filtered(filterRows_, layout_.width);
+  const demux::RowBlock derivs(derivativeRows_, layout_.width);
   demux::separate(smoothed_, layout_, projector, tileDirections_, tileInverseColour_, columns_,
                   rows_, units_[0], filtered, derivs,
                   std::span<const DirectionPlane>(directions_.data(),
                                                   static_cast<std::size_t>(layout_.projectors)),
                   separated_, order_);
-  // Q4.11 threshold from per mille.
-  const int minStrength = (layout_.params.minStrengthPermille << demux::kRelativeShift) / 1000;
-  demux::detectBoundaries(separated_, order_, directions_[p], units_[0], minStrength, strength_,
-                          boundaries_[p]);
+  demux::detectBoundaries(separated_, order_, directions_[p], units_[0],
+                          demux::minStrengthQ11(layout_.params), strength_, boundaries_[p]);
   return {};
 }
 

@@ -65,7 +65,7 @@ std::int32_t strengthOf(const Response& r) {
   return hi - lo;
 }
 
-Boundary classify(const Response& r, std::int32_t offsetQ8) {
+Boundary classify(const Response& r) {
   int to = 0;
   int from = 0;
   for (int c = 1; c < 3; ++c) {
@@ -77,7 +77,6 @@ Boundary classify(const Response& r, std::int32_t offsetQ8) {
   std::int32_t dev = 2 * r.n[third] - r.n[to] - r.n[from];
   dev = dev < 0 ? -dev : dev;
   Boundary b;
-  b.offset = static_cast<std::int16_t>(offsetQ8);
   b.transition = Boundary::code(
       stripe::transitionBetween(stripe::colourFromIndex(from), stripe::colourFromIndex(to)));
   const std::int32_t conf = range > 0 ? (255 * (range - dev)) / range : 0;
@@ -185,13 +184,11 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
         continue;
       }
       const std::int32_t den = ahead + behind - 2 * s0;  // < 0 at a strict maximum
-      std::int32_t offset = den < 0 ? (128 * (behind - ahead)) / den : 0;
-      Boundary found = classify(responseAt(separated, o[x], x, y, ux, uy), 0);
-      if (o[x] == 2) {
-        offset = zeroCrossingQ8(separated, found, x, y, ux, uy, offset);
-      }
-      found.offset =
-          static_cast<std::int16_t>(offset > 128 ? 128 : (offset < -128 ? -128 : offset));
+      const std::int32_t parabola = den < 0 ? (128 * (behind - ahead)) / den : 0;
+      Boundary found = classify(responseAt(separated, o[x], x, y, ux, uy));
+      const std::int32_t offset =
+          o[x] == 2 ? zeroCrossingQ8(separated, found, x, y, ux, uy, parabola) : parabola;
+      found.offset = static_cast<std::int16_t>(std::clamp(offset, -128, 128));
       b[x] = found;
     }
   }

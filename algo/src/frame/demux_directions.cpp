@@ -29,10 +29,6 @@ constexpr int kBinShift = 10;   // kBinRaw = 2^10
 constexpr int kMaxLobes = 8;
 constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
-std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
-  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
-}
-
 struct Lobe {
   std::uint64_t weight = 0;  // histogram mass within ±kShareBins of the peak
   std::uint16_t angle2 = 0;  // refined doubled angle
@@ -70,92 +66,105 @@ Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
 // Presence stays 0.
 constexpr int kFillRadius = 2;
 
-// Tile estimates scatter by a few degrees where lobes are broad (three patterns) and single tiles
-// go astray; the field itself varies slowly. Each found tile takes the median offset from the
-// prediction over the found tiles of its 3×3 neighbourhood.
-void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
-                       std::span<TileDirection> out, std::span<std::uint16_t> scratch) {
-  const int tilesX = layout.tilesX();
-  const int tilesY = layout.tilesY();
-  const std::size_t tileCount = layout.tileCount();
-  const auto projectors = static_cast<std::size_t>(layout.projectors);
-  for (std::size_t p = 0; p < projectors; ++p) {
-    const std::span<TileDirection> tiles = out.subspan(p * tileCount, tileCount);
-    for (int ty = 0; ty < tilesY; ++ty) {
-      for (int tx = 0; tx < tilesX; ++tx) {
-        const auto t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
-                       static_cast<std::size_t>(tx);
-        scratch[t] = tiles[t].angle;
-        if (tiles[t].present == 0) {
+// One projector's tile directions beside the predictions they are offsets from.
+struct ProjectorTiles {
+  std::span<TileDirection> tiles;
+  std::span<const std::uint16_t> predicted;  // tile-major, every projector
+  std::size_t projector;
+  std::size_t projectors;
+  int tilesX;
+  int tilesY;
+
+  [[nodiscard]] std::uint16_t prediction(std::size_t tile) const {
+    return predicted[tile * projectors + projector];
+  }
+  // Calls visit(offset from the prediction) for each found tile within ±radius of (tx, ty).
+  template <class Visit>
+  void forEachFoundAround(int tx, int ty, int radius, Visit visit) const {
+    for (int j = ty - radius; j <= ty + radius; ++j) {
+      for (int i = tx - radius; i <= tx + radius; ++i) {
+        if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
           continue;
         }
-        std::int32_t offsets[9];
-        int count = 0;
-        for (int j = ty - 1; j <= ty + 1; ++j) {
-          for (int i = tx - 1; i <= tx + 1; ++i) {
-            if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-              continue;
-            }
-            const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
-                           static_cast<std::size_t>(i);
-            if (tiles[n].present == 0) {
-              continue;
-            }
-            // Insertion into the sorted prefix.
-            const std::int32_t value = wrapDiff(tiles[n].angle, predicted[n * projectors + p]);
-            int k = count++;
-            for (; k > 0 && offsets[k - 1] > value; --k) {
-              offsets[k] = offsets[k - 1];
-            }
-            offsets[k] = value;
-          }
+        const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
+                       static_cast<std::size_t>(i);
+        if (tiles[n].present != 0) {
+          visit(wrapDiff(tiles[n].angle, prediction(n)));
         }
-        scratch[t] = static_cast<std::uint16_t>(predicted[t * projectors + p] +
-                                                static_cast<std::uint16_t>(offsets[count / 2]));
       }
     }
-    for (std::size_t t = 0; t < tileCount; ++t) {
-      tiles[t].angle = scratch[t];
+  }
+};
+
+ProjectorTiles projectorTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+                              std::span<TileDirection> out, std::size_t projector) {
+  const std::size_t tileCount = layout.tileCount();
+  return {out.subspan(projector * tileCount, tileCount), predicted,       projector,
+          static_cast<std::size_t>(layout.projectors),   layout.tilesX(), layout.tilesY()};
+}
+
+// Calls fix(tile index, tx, ty) for every tile.
+template <class Fix>
+void forEachTile(const ProjectorTiles& tiles, Fix fix) {
+  for (int ty = 0; ty < tiles.tilesY; ++ty) {
+    for (int tx = 0; tx < tiles.tilesX; ++tx) {
+      fix(static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles.tilesX) +
+              static_cast<std::size_t>(tx),
+          tx, ty);
+    }
+  }
+}
+
+// Tile estimates scatter by a few degrees where lobes are broad (three patterns) and single tiles
+// go astray; the field itself varies slowly. Each found tile takes the median offset from the
+// prediction over the found tiles of its 3×3 neighbourhood (through scratch, so that every
+// median sees unfiltered neighbours).
+void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+                       std::span<TileDirection> out, std::span<std::uint16_t> scratch) {
+  for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
+    const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
+    forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
+      scratch[t] = tiles.tiles[t].angle;
+      if (tiles.tiles[t].present == 0) {
+        return;
+      }
+      std::int32_t offsets[9] = {};  // the tile itself is found: count >= 1
+      int count = 0;
+      tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) {
+        int k = count++;  // insertion into the sorted prefix
+        for (; k > 0 && offsets[k - 1] > value; --k) {
+          offsets[k] = offsets[k - 1];
+        }
+        offsets[k] = value;
+      });
+      scratch[t] = static_cast<std::uint16_t>(tiles.prediction(t) +
+                                              static_cast<std::uint16_t>(offsets[count / 2]));
+    });
+    for (std::size_t t = 0; t < tiles.tiles.size(); ++t) {
+      tiles.tiles[t].angle = scratch[t];
     }
   }
 }
 
 void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
                      std::span<TileDirection> out) {
-  const int tilesX = layout.tilesX();
-  const int tilesY = layout.tilesY();
-  const std::size_t tileCount = layout.tileCount();
-  const auto projectors = static_cast<std::size_t>(layout.projectors);
-  for (std::size_t p = 0; p < projectors; ++p) {
-    const std::span<TileDirection> tiles = out.subspan(p * tileCount, tileCount);
-    for (int ty = 0; ty < tilesY; ++ty) {
-      for (int tx = 0; tx < tilesX; ++tx) {
-        const auto t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
-                       static_cast<std::size_t>(tx);
-        if (tiles[t].present != 0) {
-          continue;
-        }
-        std::int32_t sum = 0;
-        std::int32_t count = 0;
-        for (int j = ty - kFillRadius; j <= ty + kFillRadius; ++j) {
-          for (int i = tx - kFillRadius; i <= tx + kFillRadius; ++i) {
-            if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-              continue;
-            }
-            const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
-                           static_cast<std::size_t>(i);
-            if (tiles[n].present != 0) {
-              sum += wrapDiff(tiles[n].angle, predicted[n * projectors + p]);
-              ++count;
-            }
-          }
-        }
-        if (count > 0) {
-          tiles[t].angle = static_cast<std::uint16_t>(predicted[t * projectors + p] +
-                                                      static_cast<std::uint16_t>(sum / count));
-        }
+  for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
+    const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
+    forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
+      if (tiles.tiles[t].present != 0) {
+        return;
       }
-    }
+      std::int32_t sum = 0;
+      std::int32_t count = 0;
+      tiles.forEachFoundAround(tx, ty, kFillRadius, [&](std::int32_t value) {
+        sum += value;
+        ++count;
+      });
+      if (count > 0) {
+        tiles.tiles[t].angle = static_cast<std::uint16_t>(tiles.prediction(t) +
+                                                          static_cast<std::uint16_t>(sum / count));
+      }
+    });
   }
 }
 
@@ -301,7 +310,6 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
         d.angle =
             predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
         d.present = 0;
-        d.sharePct = 0;
       }
       // Each projector's tolerance: the cap, and at most half the doubled-angle distance to the
       // nearest other predicted axis (tilted surfaces turn stripes far from the prediction; two
@@ -361,7 +369,6 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
         }
         d.angle = angle;
         d.present = 1;
-        d.sharePct = static_cast<std::uint8_t>((lobes[bestL].weight * 100) / total);
       }
     }
   }

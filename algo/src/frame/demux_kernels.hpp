@@ -92,34 +92,44 @@ struct TileInterp {
 };
 void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
 
-// The ring of horizontally filtered rows separate() streams through: 5 rows × 3 channels ×
-// (prefilter, first, second derivative) × width int32.
-class FilterRows {
+// Rows of int32 values of one width, carved from the arena: separate()'s working rows.
+class RowBlock {
  public:
-  static constexpr int kSlots = 5;
-  FilterRows() = default;
-  FilterRows(std::span<std::int32_t> memory, int width);
-  [[nodiscard]] static std::size_t valuesFor(int width);
-  [[nodiscard]] std::int32_t* row(int slot, int channel, int filter) const;
+  RowBlock() = default;
+  RowBlock(std::span<std::int32_t> memory, int width)
+      : memory_(memory), width_(static_cast<std::size_t>(width)) {}
+  [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
+    return rows * static_cast<std::size_t>(width);
+  }
+  [[nodiscard]] std::int32_t* row(std::size_t index) const {
+    return memory_.data() + index * width_;
+  }
 
  private:
   std::span<std::int32_t> memory_;
   std::size_t width_ = 0;
 };
 
-// One row of derivatives per channel, separate() steers from: gx, gy, hxx, hyy, hxy (int32).
-class DerivativeRows {
- public:
-  static constexpr int kKinds = 5;
-  DerivativeRows() = default;
-  DerivativeRows(std::span<std::int32_t> memory, int width);
-  [[nodiscard]] static std::size_t valuesFor(int width);
-  [[nodiscard]] std::int32_t* row(std::size_t channel, int kind) const;
+// The ring of horizontally filtered rows separate() streams through: 5 slots (rows y − 2 … y + 2)
+// × 3 channels × (prefilter, first, second derivative).
+inline constexpr int kFilterSlots = 5;
+inline constexpr std::size_t kFilterRows = std::size_t{kFilterSlots} * 3 * 3;
+[[nodiscard]] constexpr std::size_t filterRowIndex(int slot, int channel, int filter) {
+  return (static_cast<std::size_t>(slot) * 3 + static_cast<std::size_t>(channel)) * 3 +
+         static_cast<std::size_t>(filter);
+}
 
- private:
-  std::span<std::int32_t> memory_;
-  std::size_t width_ = 0;
-};
+// The derivatives of the current row separate() steers from, per channel: gx, gy, hxx, hyy, hxy.
+enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
+inline constexpr std::size_t kDerivativeRows = std::size_t{3} * kDerivativeKinds;
+[[nodiscard]] constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
+  return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
+}
+
+// The signed difference a − b of two BinAngle raw values, wrapped into [−2^15, 2^15).
+[[nodiscard]] inline std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
+  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
+}
 
 // Every projector's direction plane: its tile angles interpolated bilinearly between tile
 // centres (as wrapped differences, int64).
@@ -132,9 +142,14 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const FilterRows& filtered, const DerivativeRows& derivs,
+              const UnitTable& units, const RowBlock& filtered, const RowBlock& derivs,
               std::span<const DirectionPlane> directions, const Planes3& separated,
               ImageView<std::uint8_t> order);
+
+// detectBoundaries()'s minStrength: the parameter's per mille of the local colour in Q4.11.
+[[nodiscard]] constexpr int minStrengthQ11(const DemuxParams& params) {
+  return (params.minStrengthPermille << kRelativeShift) / 1000;
+}
 
 // Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
 // suppression along the encoding direction, sub-pixel offset and class.

@@ -18,18 +18,11 @@
 #include <cstdint>
 
 #include "demux_kernels.hpp"
+#include "smx/algo/fixed.hpp"
 
 namespace smx::algo::demux {
 
 namespace {
-
-std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
-  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
-}
-
-std::int16_t saturate16(std::int64_t v) {
-  return static_cast<std::int16_t>(v > 32767 ? 32767 : (v < -32768 ? -32768 : v));
-}
 
 struct Vec {
   std::int32_t x;
@@ -124,30 +117,6 @@ void verticalSecond(const std::int32_t* const (&rows)[5], std::int32_t* __restri
 
 }  // namespace
 
-FilterRows::FilterRows(std::span<std::int32_t> memory, int width)
-    : memory_(memory), width_(static_cast<std::size_t>(width)) {}
-
-DerivativeRows::DerivativeRows(std::span<std::int32_t> memory, int width)
-    : memory_(memory), width_(static_cast<std::size_t>(width)) {}
-
-std::size_t DerivativeRows::valuesFor(int width) {
-  return 3 * std::size_t{kKinds} * static_cast<std::size_t>(width);
-}
-
-std::int32_t* DerivativeRows::row(std::size_t channel, int kind) const {
-  return memory_.data() + (channel * kKinds + static_cast<std::size_t>(kind)) * width_;
-}
-
-std::size_t FilterRows::valuesFor(int width) {
-  return static_cast<std::size_t>(kSlots) * 3 * 3 * static_cast<std::size_t>(width);
-}
-
-std::int32_t* FilterRows::row(int slot, int channel, int filter) const {
-  const auto index = (static_cast<std::size_t>(slot) * 3 + static_cast<std::size_t>(channel)) * 3 +
-                     static_cast<std::size_t>(filter);
-  return memory_.data() + index * width_;
-}
-
 void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
                            std::span<const DirectionPlane> out) {
@@ -183,7 +152,7 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
 void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const FilterRows& filtered, const DerivativeRows& derivs,
+              const UnitTable& units, const RowBlock& filtered, const RowBlock& derivs,
               std::span<const DirectionPlane> directions, const Planes3& separated,
               ImageView<std::uint8_t> order) {
   const int w = layout.width;
@@ -205,12 +174,13 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
   // Tile columns are at most 8192 / 4.
   std::uint8_t presentBits[2048] = {};
   // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
-  const auto slotOf = [](int row) { return (row + FilterRows::kSlots) % FilterRows::kSlots; };
+  const auto slotOf = [](int row) { return (row + kFilterSlots) % kFilterSlots; };
   const auto fill = [&](int row) {
     for (int c = 0; c < 3; ++c) {
       const int slot = slotOf(row);
-      filterRow(smoothed[static_cast<std::size_t>(c)].rowPtr(row), w, filtered.row(slot, c, 0),
-                filtered.row(slot, c, 1), filtered.row(slot, c, 2));
+      filterRow(smoothed[static_cast<std::size_t>(c)].rowPtr(row), w,
+                filtered.row(filterRowIndex(slot, c, 0)), filtered.row(filterRowIndex(slot, c, 1)),
+                filtered.row(filterRowIndex(slot, c, 2)));
     }
   };
   for (int row = 0; row < 4 && row < h; ++row) {
@@ -246,16 +216,16 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
       const std::int32_t* d2[5] = {};
       for (int k = 0; k < 5; ++k) {
         const int slot = slotOf(y + k - 2);
-        pre[k] = filtered.row(slot, static_cast<int>(c), 0);
-        d1[k] = filtered.row(slot, static_cast<int>(c), 1);
-        d2[k] = filtered.row(slot, static_cast<int>(c), 2);
+        pre[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 0));
+        d1[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 1));
+        d2[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 2));
       }
-      verticalSmoothed(d1, derivs.row(c, 0), w);
-      verticalDerivative(pre, derivs.row(c, 1), w);
+      verticalSmoothed(d1, derivs.row(derivativeRowIndex(c, kGx)), w);
+      verticalDerivative(pre, derivs.row(derivativeRowIndex(c, kGy)), w);
       if (second) {
-        verticalSmoothed(d2, derivs.row(c, 2), w);
-        verticalSecond(pre, derivs.row(c, 3), w);
-        verticalDerivative(d1, derivs.row(c, 4), w);
+        verticalSmoothed(d2, derivs.row(derivativeRowIndex(c, kHxx)), w);
+        verticalSecond(pre, derivs.row(derivativeRowIndex(c, kHyy)), w);
+        verticalDerivative(d1, derivs.row(derivativeRowIndex(c, kHxy)), w);
       }
     }
     for (int x = 0; x < w; ++x) {
@@ -284,7 +254,9 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
       if (otherCount < 2) {
         const Vec v = otherCount == 0 ? own : others[0];
         for (std::size_t c = 0; c < 3; ++c) {
-          raw[c] = (v.x * derivs.row(c, 0)[x] + v.y * derivs.row(c, 1)[x]) >> kSteerShift;
+          raw[c] = (v.x * derivs.row(derivativeRowIndex(c, kGx))[x] +
+                    v.y * derivs.row(derivativeRowIndex(c, kGy))[x]) >>
+                   kSteerShift;
         }
       } else {
         // Q1.14 coefficients of the mixed derivative; |cxx| + |cxy| + |cyy| <= 2^15.
@@ -294,9 +266,10 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
         const std::int32_t cyy = (v.y * u.y) >> kUnitShift;
         const std::int32_t cxy = (v.x * u.y + v.y * u.x) >> kUnitShift;
         for (std::size_t c = 0; c < 3; ++c) {
-          raw[c] =
-              (cxx * derivs.row(c, 2)[x] + cxy * derivs.row(c, 4)[x] + cyy * derivs.row(c, 3)[x]) >>
-              kSteerShift;
+          raw[c] = (cxx * derivs.row(derivativeRowIndex(c, kHxx))[x] +
+                    cxy * derivs.row(derivativeRowIndex(c, kHxy))[x] +
+                    cyy * derivs.row(derivativeRowIndex(c, kHyy))[x]) >>
+                   kSteerShift;
         }
       }
       // Below the contrast floor (noise in shadows and on black) nothing is separated: the
@@ -304,10 +277,10 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
       const std::int32_t hi = std::max({raw[0], raw[1], raw[2]});
       const std::int32_t lo = std::min({raw[0], raw[1], raw[2]});
       for (std::size_t c = 0; c < 3; ++c) {
-        out[c][x] =
-            hi - lo < minContrast
-                ? std::int16_t{0}
-                : saturate16((std::int64_t{raw[c]} * inverseColour[colourTile + c]) >> kNormShift);
+        out[c][x] = hi - lo < minContrast
+                        ? std::int16_t{0}
+                        : saturateCast<std::int16_t>(
+                              (std::int64_t{raw[c]} * inverseColour[colourTile + c]) >> kNormShift);
       }
       orderRow[x] = otherCount < 2 ? 1 : 2;
     }

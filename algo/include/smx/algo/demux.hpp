@@ -64,9 +64,8 @@ struct DemuxLayout {
 
 // What the direction stage found in one tile for one projector.
 struct TileDirection {
-  std::uint16_t angle = 0;    // BinAngle raw of the encoding direction (estimated or predicted)
-  std::uint8_t present = 0;   // 1 when the pattern's lobe was found in the tile's window
-  std::uint8_t sharePct = 0;  // the lobe's share of the window's gradient weight
+  std::uint16_t angle = 0;   // BinAngle raw of the encoding direction (estimated or predicted)
+  std::uint8_t present = 0;  // 1 when the pattern's lobe was found in the tile's window
 };
 
 namespace demux {
@@ -94,11 +93,9 @@ class Demultiplexer {
   // tileCount() entries for the projector, row-major over tiles.
   [[nodiscard]] std::span<const TileDirection> tileDirections(int projector) const;
 
-  // Debug views of the last projector separated by run() (or by separateOnly()): its
-  // colour-normalised derivative per channel (Q4.11 of the local average colour) and the
-  // boundary strength.
+  // Debug view of the last projector separated by run() (or by separateOnly()): its
+  // colour-normalised derivative per channel (Q4.11 of the local average colour).
   [[nodiscard]] ImageView<const std::int16_t> separated(int channel) const;
-  [[nodiscard]] ImageView<const std::uint16_t> strength() const { return strength_; }
   // Repeats stages 3–5 of the last run() for one projector, so that its debug views can be read.
   [[nodiscard]] Result<void> separateOnly(int projector);
 
