@@ -1,4 +1,5 @@
-// Speed of orientation demultiplexing (docs/demux.md "Speed"), single thread, against one
+// Speed of orientation demultiplexing (docs/demux.md "Speed") and of the whole pipeline
+// (docs/decode.md "Speed"), single thread, against one
 // OpenCV cv::Sobel (CV_16S, 3×3, x only) over the same RGB frame measured in the same process.
 // Run:
 //   build/host/tests/bench/demux_bench
@@ -16,10 +17,14 @@
 //                      separate and boundaries cover all projectors. Before timing, the stage
 //                      chain is run once and its boundaries and directions are checked equal to
 //                      run()'s.
+//   <cfg>/pipeline     CameraPipeline::run(): demux, decode, triangulate and merge (docs/decode.md);
+//   <cfg>/p_decode, p_triangulate, p_merge
+//                      those stages alone, on the output of the pipeline's last run.
 // Counters: px/s (frame pixels per CPU second); x_sobel = this benchmark's CPU time per frame /
 // one Sobel's CPU time measured at start-up (the mean of kSobelCalls calls after kSobelWarmUp
 // untimed ones, on the same frame, before any benchmark runs; the <cfg>/sobel benchmark's own
-// x_sobel checks that figure); arena = the configuration's Demultiplexer::workspaceBytes().
+// x_sobel checks that figure); arena = the configuration's Demultiplexer::workspaceBytes(), or
+// CameraPipeline::workspaceBytes() for the pipeline benchmarks.
 // CPU time is the thread's (CLOCK_THREAD_CPUTIME_ID, the clock of Google Benchmark's CPU
 // column): on a shared 2-core machine it is what the code costs, where wall time (the Time
 // column, and the steady_clock Sobel figure printed at start-up) also counts other processes.
@@ -47,6 +52,7 @@
 #include "demux_kernels.hpp"
 #include "sim_frame.hpp"
 #include "smx/algo/arena.hpp"
+#include "smx/algo/camera_pipeline.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/encoding_prediction.hpp"
 
@@ -259,6 +265,11 @@ struct Config {
   std::unique_ptr<algo::Arena> arena;
   std::unique_ptr<algo::Demultiplexer> demux;
   std::unique_ptr<Stages> stages;
+  // The whole pipeline of the same camera (demux, decode, triangulate, merge) over its own arena.
+  std::size_t pipelineBytes = 0;
+  std::vector<std::byte> pipelineMemory;
+  std::unique_ptr<algo::Arena> pipelineArena;
+  std::unique_ptr<algo::CameraPipeline> pipeline;
   cv::Mat sobelSrc;  // the frame, not copied
   cv::Mat sobelDst;
   double sobelSecondsPerCall = 0.0;  // thread CPU time
@@ -325,6 +336,25 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled) {
     die(c->name + ": the stage chain's boundaries or directions differ from run()'s");
   }
 
+  algo::PipelineOptions options;
+  options.nominalDepthM = kNominalDepthM;
+  const auto setup = algo::prepareCameraPipeline(c->frame.rig, 0, options);
+  if (!setup) {
+    die(c->name + ": prepareCameraPipeline: " + setup.error());
+  }
+  const auto pipelineBytes = algo::CameraPipeline::workspaceBytes(*setup);
+  if (!pipelineBytes) {
+    die(c->name + ": pipeline workspaceBytes: " + pipelineBytes.error().message);
+  }
+  c->pipelineBytes = *pipelineBytes;
+  c->pipelineMemory.resize(*pipelineBytes);
+  c->pipelineArena = std::make_unique<algo::Arena>(c->pipelineMemory);
+  auto pipeline = algo::CameraPipeline::create(*setup, *c->pipelineArena);
+  if (!pipeline || !pipeline->run(c->image())) {
+    die(c->name + ": the pipeline cannot be created or run");
+  }
+  c->pipeline = std::make_unique<algo::CameraPipeline>(std::move(*pipeline));
+
   // The frame as an 8-bit, 3-channel Mat (the channel order does not matter to Sobel).
   c->sobelSrc = cv::Mat(h, w, CV_8UC3, c->frame.image.pixels.data(),
                         static_cast<std::size_t>(w) * sizeof(algo::Rgb8));
@@ -353,7 +383,8 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled) {
 // read Google Benchmark's timer), which matches the CPU column to well under a per cent at
 // these durations.
 template <class Body>
-void timeFrames(benchmark::State& state, const Config& c, const Body& body) {
+void timeFrames(benchmark::State& state, const Config& c, std::size_t arenaBytes,
+                const Body& body) {
   const double cpu0 = threadCpuSeconds();
   for (auto _ : state) {
     body();
@@ -364,16 +395,21 @@ void timeFrames(benchmark::State& state, const Config& c, const Body& body) {
   state.counters["px/s"] = benchmark::Counter(c.pixels() * frames, benchmark::Counter::kIsRate);
   state.counters["x_sobel"] = frames > 0 ? seconds / frames / c.sobelSecondsPerCall : 0.0;
   state.counters["arena"] =
-      benchmark::Counter(static_cast<double>(c.arenaBytes), benchmark::Counter::kDefaults,
+      benchmark::Counter(static_cast<double>(arenaBytes), benchmark::Counter::kDefaults,
                          benchmark::Counter::kIs1024);
 }
 
 // Registers <cfg>/sobel, <cfg>/demux and the stages; c outlives the benchmarks.
 void registerConfig(Config* c) {
-  const auto add = [c](const std::string& what, auto body) {
-    benchmark::RegisterBenchmark((c->name + "/" + what).c_str(), [c, body](benchmark::State& s) {
-      timeFrames(s, *c, body);
-    })->Unit(benchmark::kMillisecond);
+  const auto addWith = [c](const std::string& what, std::size_t arenaBytes, auto body) {
+    benchmark::RegisterBenchmark((c->name + "/" + what).c_str(),
+                                 [c, arenaBytes, body](benchmark::State& s) {
+                                   timeFrames(s, *c, arenaBytes, body);
+                                 })
+        ->Unit(benchmark::kMillisecond);
+  };
+  const auto add = [c, addWith](const std::string& what, auto body) {
+    addWith(what, c->arenaBytes, body);
   };
   Stages* st = c->stages.get();
   add("sobel", [c] { c->sobel(); });
@@ -389,6 +425,25 @@ void registerConfig(Config* c) {
   add("6_interpolate", [st] { st->interpolate(); });
   add("7_separate", [st] { st->separate(); });
   add("8_boundaries", [st] { st->boundaries(); });
+  // The whole frame through CameraPipeline, and its stages after demultiplexing (each repeats
+  // on the previous stage's output of the last run()).
+  algo::CameraPipeline* p = c->pipeline.get();
+  addWith("pipeline", c->pipelineBytes, [c, p] {
+    auto ok = p->run(c->image());
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p_decode", c->pipelineBytes, [p] {
+    auto ok = p->decode();
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p_triangulate", c->pipelineBytes, [p] {
+    auto ok = p->triangulate();
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p_merge", c->pipelineBytes, [p] {
+    auto ok = p->merge();
+    benchmark::DoNotOptimize(ok);
+  });
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addPatternCommand(app, io, exitCode);
   addSimCommand(app, io, exitCode);
   addDemuxCommand(app, io, exitCode);
+  addDecodeCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -11,6 +11,7 @@
 #include <system_error>
 #include <vector>
 
+#include "camera_images.hpp"
 #include "commands.hpp"
 #include "demux_debug.hpp"
 #include "smx/algo/demux.hpp"
@@ -30,58 +31,6 @@ struct DemuxOptions {
   double nominalDepthM = 0.9;
 };
 
-struct CameraImage {
-  std::size_t camera;
-  fs::path file;
-};
-
-std::expected<std::vector<CameraImage>, std::string> parseImages(
-    const std::vector<std::string>& specs, const algo::Rig& rig) {
-  std::vector<CameraImage> out;
-  for (const auto& spec : specs) {
-    const auto eq = spec.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
-      return std::unexpected("--image " + spec + ": expected CAMERA=FILE, e.g. cam0=frame.png");
-    }
-    const std::string id = spec.substr(0, eq);
-    std::optional<std::size_t> index;
-    std::string known;
-    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
-      index = rig.cameras[c].id == id ? std::optional(c) : index;
-      known += (known.empty() ? "" : ", ") + rig.cameras[c].id;
-    }
-    if (!index) {
-      std::string message = "--image " + spec;
-      message += ": the rig has no camera \"";
-      message += id;
-      message += "\" (cameras: ";
-      message += known;
-      message += ")";
-      return std::unexpected(message);
-    }
-    out.push_back({*index, spec.substr(eq + 1)});
-  }
-  return out;
-}
-
-std::expected<void, std::string> writeDebug(const fs::path& dir, const std::string& tag,
-                                            const algo::Demultiplexer& demux, int projector) {
-  const algo::ImageView<const std::int16_t> separated[3] = {demux.separated(0), demux.separated(1),
-                                                            demux.separated(2)};
-  const std::pair<const char*, sim::RgbImage> images[] = {
-      {".boundaries.png", renderBoundaries(demux.boundaries(projector))},
-      {".separated.png", renderSeparated(separated)},
-      {".direction.png",
-       renderDirections(demux.directions(projector), demux.boundaries(projector))},
-  };
-  for (const auto& [suffix, image] : images) {
-    if (auto ok = sim::writePngRgb8(dir / (tag + suffix), image.view()); !ok) {
-      return ok;
-    }
-  }
-  return {};
-}
-
 int runDemux(const DemuxOptions& opts, const CliStreams& io) {
   const auto fail = [&](int code, const std::string& message) {
     io.err << "stripemux demux: " << message << "\n";
@@ -91,7 +40,7 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
   if (!rig) {
     return fail(kExitBadInput, rig.error().message());
   }
-  const auto images = parseImages(opts.images, *rig);
+  const auto images = parseCameraImages(opts.images, *rig);
   if (!images) {
     return fail(kExitBadInput, images.error());
   }
@@ -105,15 +54,9 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
   }
   for (const auto& [cameraIndex, file] : *images) {
     const algo::Camera& camera = rig->cameras[cameraIndex];
-    const auto image = sim::readPngRgb8(file);
+    const auto image = readCameraImage(file, camera);
     if (!image) {
       return fail(kExitBadInput, image.error());
-    }
-    if (image->width != camera.width || image->height != camera.height) {
-      return fail(kExitBadInput, file.string() + ": image is " + std::to_string(image->width) +
-                                     "x" + std::to_string(image->height) + ", camera " + camera.id +
-                                     " is " + std::to_string(camera.width) + "x" +
-                                     std::to_string(camera.height));
     }
     const algo::DemuxLayout layout{
         camera.width, camera.height, static_cast<int>(rig->projectors.size()), {}};
@@ -160,7 +103,7 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
           return fail(kExitBadInput, ok.error().message);
         }
         const std::string tag = projector.id + "." + camera.id;
-        if (auto ok = writeDebug(*opts.debug, tag, *demux, p); !ok) {
+        if (auto ok = writeDemuxDebug(*opts.debug, tag, *demux, p); !ok) {
           return fail(kExitDeviceOrIo, ok.error());
         }
         io.out << "    wrote "

@@ -10,5 +10,6 @@ namespace smx::host {
 void addPatternCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addDemuxCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

@@ -1,5 +1,7 @@
 #include "demux_debug.hpp"
 
+#include "colour_map.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -8,13 +10,6 @@ namespace smx::host {
 
 namespace {
 
-sim::RgbImage blank(int width, int height) {
-  return {
-      width, height,
-      std::vector<algo::Rgb8>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
-                              algo::Rgb8{0, 0, 0})};
-}
-
 std::uint8_t clip(double v) {
   return static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
 }
@@ -22,7 +17,7 @@ std::uint8_t clip(double v) {
 }  // namespace
 
 sim::RgbImage renderBoundaries(algo::ConstBoundaryPlane boundaries) {
-  sim::RgbImage out = blank(boundaries.width(), boundaries.height());
+  sim::RgbImage out = blankImage(boundaries.width(), boundaries.height());
   for (int y = 0; y < boundaries.height(); ++y) {
     for (int x = 0; x < boundaries.width(); ++x) {
       const algo::Boundary b = boundaries(x, y);
@@ -52,7 +47,7 @@ sim::RgbImage renderBoundaries(algo::ConstBoundaryPlane boundaries) {
 sim::RgbImage renderSeparated(const algo::ImageView<const std::int16_t> (&channels)[3]) {
   const int w = channels[0].width();
   const int h = channels[0].height();
-  sim::RgbImage out = blank(w, h);
+  sim::RgbImage out = blankImage(w, h);
   // Q4.11: ±1 (a step of the local average colour per pixel) spans ±127 grey levels.
   constexpr double kGain = 127.0 / 2048.0;
   for (int y = 0; y < h; ++y) {
@@ -70,7 +65,7 @@ sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
                                algo::ConstBoundaryPlane boundaries) {
   const int w = directions.width();
   const int h = directions.height();
-  sim::RgbImage out = blank(w, h);
+  sim::RgbImage out = blankImage(w, h);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       bool near = false;
@@ -81,45 +76,31 @@ sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
           near = boundaries(nx, ny).present();
         }
       }
-      const double hue = directions(x, y) * (6.0 / 65536.0);  // sextants of the colour wheel
-      const double f = hue - std::floor(hue);
-      const double value = near ? 255.0 : 110.0;
-      const double rising = value * f;
-      const double falling = value * (1.0 - f);
-      double r = 0;
-      double g = 0;
-      double b = 0;
-      switch (static_cast<int>(hue)) {
-        case 0:
-          r = value;
-          g = rising;
-          break;
-        case 1:
-          r = falling;
-          g = value;
-          break;
-        case 2:
-          g = value;
-          b = rising;
-          break;
-        case 3:
-          g = falling;
-          b = value;
-          break;
-        case 4:
-          r = rising;
-          b = value;
-          break;
-        default:
-          r = value;
-          b = falling;
-          break;
-      }
       out.pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-                 static_cast<std::size_t>(x)] = {clip(r), clip(g), clip(b)};
+                 static_cast<std::size_t>(x)] =
+          hueColour(directions(x, y) / 65536.0, near ? 1.0 : 110.0 / 255.0);
     }
   }
   return out;
+}
+
+std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& dir,
+                                                 const std::string& tag,
+                                                 const algo::Demultiplexer& demux, int projector) {
+  const algo::ImageView<const std::int16_t> separated[3] = {demux.separated(0), demux.separated(1),
+                                                            demux.separated(2)};
+  const std::pair<const char*, sim::RgbImage> images[] = {
+      {".boundaries.png", renderBoundaries(demux.boundaries(projector))},
+      {".separated.png", renderSeparated(separated)},
+      {".direction.png",
+       renderDirections(demux.directions(projector), demux.boundaries(projector))},
+  };
+  for (const auto& [suffix, image] : images) {
+    if (auto ok = sim::writePngRgb8(dir / (tag + suffix), image.view()); !ok) {
+      return ok;
+    }
+  }
+  return {};
 }
 
 }  // namespace smx::host

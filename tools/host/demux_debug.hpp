@@ -1,6 +1,11 @@
 #pragma once
 
+#include <expected>
+#include <filesystem>
+#include <string>
+
 #include "smx/algo/boundary_map.hpp"
+#include "smx/algo/demux.hpp"
 #include "smx/algo/image_view.hpp"
 #include "smx/sim/png_io.hpp"
 
@@ -21,5 +26,12 @@ namespace smx::host {
 // boundary within the pixel's 3×3 neighbourhood brighter.
 [[nodiscard]] sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
                                              algo::ConstBoundaryPlane boundaries);
+
+// Writes the three renderings above of one projector as DIR/<tag>.{boundaries,separated,
+// direction}.png; the separated view is the last projector separated (Demultiplexer::separated).
+[[nodiscard]] std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& dir,
+                                                               const std::string& tag,
+                                                               const algo::Demultiplexer& demux,
+                                                               int projector);
 
 }  // namespace smx::host

@@ -46,26 +46,6 @@ Result<void> validate(const DemuxLayout& l) {
   return {};
 }
 
-template <class T, class Carver>
-Result<void> take(Carver& carver, std::span<T>& out, std::size_t count) {
-  auto span = carver.template allocate<T>(count);
-  if (!span) {
-    return std::unexpected(span.error());
-  }
-  out = *span;
-  return {};
-}
-
-template <class P, class Carver>
-Result<void> takeImage(Carver& carver, ImageView<P>& out, const DemuxLayout& l) {
-  auto view = carver.template allocateImage<P>(l.width, l.height);
-  if (!view) {
-    return std::unexpected(view.error());
-  }
-  out = *view;
-  return {};
-}
-
 }  // namespace
 
 template <class Carver>
@@ -79,30 +59,30 @@ Result<void> Demultiplexer::carve(Carver& carver) {
       ok = r;
     }
   };
-  step(take(carver, predicted_, tiles * projectors));
-  step(take(carver, units_, 1));
-  step(take(carver, columns_, static_cast<std::size_t>(l.width)));
-  step(take(carver, rows_, static_cast<std::size_t>(l.height)));
-  step(take(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
-  step(take(carver, filterRows_, demux::RowBlock::valuesFor(demux::kFilterRows, l.width)));
-  step(take(carver, derivativeRows_, demux::RowBlock::valuesFor(demux::kDerivativeRows, l.width)));
-  step(take(carver, tileHistograms_, tiles * demux::kBins));
-  step(take(carver, tileMoments_, tiles * demux::kBins));
-  step(take(carver, tileColourSums_, tiles * 3));
-  step(take(carver, tileInverseColour_, tiles * 3));
-  step(take(carver, tileDirections_, tiles * projectors));
-  step(take(carver, tileScratch_, tiles));
+  step(carveSpan(carver, predicted_, tiles * projectors));
+  step(carveSpan(carver, units_, 1));
+  step(carveSpan(carver, columns_, static_cast<std::size_t>(l.width)));
+  step(carveSpan(carver, rows_, static_cast<std::size_t>(l.height)));
+  step(carveSpan(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
+  step(carveSpan(carver, filterRows_, demux::RowBlock::valuesFor(demux::kFilterRows, l.width)));
+  step(carveSpan(carver, derivativeRows_, demux::RowBlock::valuesFor(demux::kDerivativeRows, l.width)));
+  step(carveSpan(carver, tileHistograms_, tiles * demux::kBins));
+  step(carveSpan(carver, tileMoments_, tiles * demux::kBins));
+  step(carveSpan(carver, tileColourSums_, tiles * 3));
+  step(carveSpan(carver, tileInverseColour_, tiles * 3));
+  step(carveSpan(carver, tileDirections_, tiles * projectors));
+  step(carveSpan(carver, tileScratch_, tiles));
   for (auto& plane : smoothed_) {
-    step(takeImage(carver, plane, l));
+    step(carveImage(carver, plane, l.width, l.height));
   }
   for (auto& plane : separated_) {
-    step(takeImage(carver, plane, l));
+    step(carveImage(carver, plane, l.width, l.height));
   }
-  step(takeImage(carver, strength_, l));
-  step(takeImage(carver, order_, l));
+  step(carveImage(carver, strength_, l.width, l.height));
+  step(carveImage(carver, order_, l.width, l.height));
   for (std::size_t p = 0; p < projectors; ++p) {
-    step(takeImage(carver, boundaries_[p], l));
-    step(takeImage(carver, directions_[p], l));
+    step(carveImage(carver, boundaries_[p], l.width, l.height));
+    step(carveImage(carver, directions_[p], l.width, l.height));
   }
   return ok;
 }

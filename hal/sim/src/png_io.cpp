@@ -53,6 +53,36 @@ std::expected<void, std::string> writePngGray8(const std::filesystem::path& path
   return writePacked(path, image, PNG_FORMAT_GRAY);
 }
 
+std::expected<void, std::string> writePngGray16(const std::filesystem::path& path,
+                                                algo::ImageView<const std::uint16_t> image) {
+  // PNG_FORMAT_LINEAR_Y: 16-bit samples written as given (big-endian in the file, gAMA 1.0).
+  return writePacked(path, image, PNG_FORMAT_LINEAR_Y);
+}
+
+std::expected<Gray16Image, std::string> readPngGray16(const std::filesystem::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  const ImageGuard guard{png};
+  if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  if (png.format != PNG_FORMAT_LINEAR_Y) {
+    return std::unexpected(path.string() + ": not a 16-bit grey PNG (" +
+                           ((png.format & PNG_FORMAT_FLAG_COLOR) != 0 ? "colour" : "grey") +
+                           ((png.format & PNG_FORMAT_FLAG_LINEAR) != 0 ? ", 16-bit" : ", 8-bit") +
+                           ((png.format & PNG_FORMAT_FLAG_ALPHA) != 0 ? ", with alpha" : "") +
+                           "); depth images are 16-bit grey");
+  }
+  Gray16Image out;
+  out.width = static_cast<int>(png.width);
+  out.height = static_cast<int>(png.height);
+  out.pixels.resize(static_cast<std::size_t>(png.width) * png.height);
+  if (png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  return out;
+}
+
 std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path) {
   png_image png{};
   png.version = PNG_IMAGE_VERSION;

@@ -107,4 +107,27 @@ class ArenaSizer {
   std::size_t bytes_ = 0;
 };
 
+// Carving helpers for stages that run the same allocation code on an ArenaSizer (to report their
+// size) and on an Arena (to take the memory): each fills `out` or returns the error.
+template <class T, class Carver>
+[[nodiscard]] Result<void> carveSpan(Carver& carver, std::span<T>& out, std::size_t count) {
+  auto span = carver.template allocate<T>(count);
+  if (!span) {
+    return std::unexpected(span.error());
+  }
+  out = *span;
+  return {};
+}
+
+template <class Pixel, class Carver>
+[[nodiscard]] Result<void> carveImage(Carver& carver, ImageView<Pixel>& out, int width,
+                                      int height) {
+  auto view = carver.template allocateImage<Pixel>(width, height);
+  if (!view) {
+    return std::unexpected(view.error());
+  }
+  out = *view;
+  return {};
+}
+
 }  // namespace smx::algo

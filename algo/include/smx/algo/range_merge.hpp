@@ -1,0 +1,34 @@
+#pragma once
+
+#include <span>
+
+#include "smx/algo/error.hpp"
+#include "smx/algo/range_image.hpp"
+
+// Merging one camera's range images, one per projector, into one (paper §4.3, "Occlusion";
+// DESIGN.md item 9; docs/decode.md). The paper's variant of the median filter:
+//
+//   For each pixel, the valid values (≠ 0) of each range image in the 3×3 window (clipped at the
+//   image border) form a set. Between two sets: if their member counts differ by more than 3,
+//   the set with more members; otherwise the one with the smaller variance, and when the
+//   variances are equal, both together. A one-member set has the largest variance; an empty set
+//   is never chosen. The output is the median of the chosen set.
+//
+// Decisions where the paper is silent:
+//   - Three or more sets: a left fold in projector order, the running choice (a set or a union)
+//     against the next non-empty set. With two sets it is the paper's rule exactly.
+//   - The median of an even count is the mean of the two middle values, rounded half up.
+//   - A pixel gets a value only where at least one range image has one at the pixel itself, so
+//     merging never grows a surface past a silhouette or into a shadow.
+//
+// Numerics: per set n ≤ 9·kMaxRanges values, Σz and Σz² in int64; variances compared exactly as
+// (n_a·Σz_a² − (Σz_a)²)·n_b² against the same for b (|·| < 72·72·72·65535² < 2^61). Integer only,
+// no heap.
+namespace smx::algo {
+
+inline constexpr int kMaxRanges = 8;
+
+// 1…kMaxRanges inputs, all the size of `out` (which may not alias them).
+[[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out);
+
+}  // namespace smx::algo

@@ -1,0 +1,109 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <expected>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "smx/algo/arena.hpp"
+#include "smx/algo/error.hpp"
+#include "smx/algo/range_image.hpp"
+#include "smx/algo/rig.hpp"
+
+// Triangulation of a decoded stripe coordinate (paper ref [20]; DESIGN.md item 8;
+// docs/triangulation.md). The stripe coordinate s of projector p is affine in the projector's
+// pixel coordinates, so with an undistorted projector a value of s is a plane through the
+// projector centre: n(s)·X_p = 0 with n(s) = n₀ − s·(0, 0, 1). A camera pixel's undistorted ray
+// is z·r, r = (x_n, y_n, 1), in the camera frame, and X_p = M·X_c + m (camera → projector), so
+//
+//     z = (A + B·s) / (C + D·s),   A = −n₀·m, B = m_z, C = n₀·(M·r), D = −(M·r)_z,
+//
+// A, B per projector–camera pair, C, D per camera pixel. The point lies in front of the
+// projector when (B·C − A·D) and (C + D·s) have the same sign (Z_p = (B·C − A·D) / (C + D·s)).
+namespace smx::algo {
+
+// Init-time tables for one projector–camera pair, in integers (buildTriangulationTables).
+// Numerics: s is Q16 (StripeQ16). den = (C' << 16) + D'·s with C', D' int32 (the per-pixel C, D
+// times 2^k, k the largest that keeps every |C'| and |D'| ≤ 2^30), so |den| < 2^47 + 2^54.
+// num = A' + B'·s, int64, A' and B' the constants A, B times 2^k·2^16 / depthUnitM (resp. 2^k /
+// depthUnitM), so that z in depth units is num / den; buildTriangulationTables lowers k until
+// |A'| + |B'|·198·2^16 < 2^62. The rounding of C', D' to integers is ≤ 2^-31 of their range.
+struct TriangulationTables {
+  int width = 0;
+  int height = 0;
+  std::int64_t numeratorBase = 0;   // A'
+  std::int64_t numeratorSlope = 0;  // B' (per Q16 unit of s)
+  std::vector<std::int32_t> denominatorBase;   // C' per pixel, row-major
+  std::vector<std::int32_t> denominatorSlope;  // D' per pixel
+  std::vector<std::int8_t> sense;  // sign(B·C − A·D) per pixel; 0 where the pixel has no ray
+};
+
+// The tables for camera `camera` and projector `projector` of the rig, depth in units of
+// depthUnitM metres. Errors name the problem: indices, depthUnitM ≤ 0, a projector with lens
+// distortion (not supported: its stripe planes would be curved surfaces), a degenerate pattern.
+[[nodiscard]] std::expected<TriangulationTables, std::string> buildTriangulationTables(
+    const Rig& rig, int camera, int projector, double depthUnitM);
+
+// Distance between the camera's and the projector's centres, metres (the triangulation
+// baseline; evaluation converts depth errors into disparity with it).
+[[nodiscard]] double baselineM(const Rig& rig, int camera, int projector);
+
+class Triangulator {
+ public:
+  // Stripe coordinates at or beyond the end of the sequence are not triangulated (they also
+  // bound the tables' integer ranges).
+  static constexpr StripeQ16 kMaxStripe = 198 * kStripeOne;
+
+  [[nodiscard]] static Result<std::size_t> workspaceBytes(int width, int height);
+  // Copies the tables into the arena.
+  [[nodiscard]] static Result<Triangulator> create(const TriangulationTables& tables,
+                                                   Arena& arena);
+
+  // z in depth units for pixel (x, y) (inside the image) and stripe coordinate s; kNoDepth
+  // where s is kNoStripe, the pixel has no ray, the point is behind the camera or the projector,
+  // the ray is (nearly) parallel to the plane, or z is not within 1…65535 units, and for s outside
+  // [0, kMaxStripe). Rounded half up.
+  [[nodiscard]] std::uint16_t depthAt(int x, int y, StripeQ16 s) const {
+    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                          static_cast<std::size_t>(x);
+    const std::int8_t sense = sense_[i];
+    if (s < 0 || s >= kMaxStripe || sense == 0) {  // kNoStripe is negative
+      return kNoDepth;
+    }
+    std::int64_t den = (std::int64_t{base_[i]} << 16) + std::int64_t{slope_[i]} * s;
+    std::int64_t num = numeratorBase_ + numeratorSlope_ * s;
+    if (den == 0 || (den > 0) != (sense > 0)) {
+      return kNoDepth;
+    }
+    if (den < 0) {
+      den = -den;
+      num = -num;
+    }
+    if (num <= 0) {
+      return kNoDepth;
+    }
+    const std::int64_t z = (num + den / 2) / den;
+    return z >= 1 && z <= 65535 ? static_cast<std::uint16_t>(z) : kNoDepth;
+  }
+
+  // depthAt for every pixel. Both planes must be width × height.
+  [[nodiscard]] Result<void> run(ConstStripePlane stripe, DepthPlane depth) const;
+
+  [[nodiscard]] int width() const { return width_; }
+  [[nodiscard]] int height() const { return height_; }
+
+ private:
+  Triangulator() = default;
+
+  int width_ = 0;
+  int height_ = 0;
+  std::int64_t numeratorBase_ = 0;
+  std::int64_t numeratorSlope_ = 0;
+  std::span<std::int32_t> base_;
+  std::span<std::int32_t> slope_;
+  std::span<std::int8_t> sense_;
+};
+
+}  // namespace smx::algo

@@ -1,0 +1,34 @@
+// Init time: the camera pipeline's tables from the rig.
+#include <string>
+
+#include "smx/algo/camera_pipeline.hpp"
+#include "smx/algo/encoding_prediction.hpp"
+
+namespace smx::algo {
+
+std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
+    const Rig& rig, int camera, const PipelineOptions& options) {
+  if (camera < 0 || camera >= static_cast<int>(rig.cameras.size())) {
+    return std::unexpected("no camera " + std::to_string(camera) + " in the rig");
+  }
+  const Camera& cam = rig.cameras[static_cast<std::size_t>(camera)];
+  CameraPipelineSetup setup;
+  setup.layout = {cam.width, cam.height, static_cast<int>(rig.projectors.size()), options.demux};
+  setup.decode = options.decode;
+  setup.depthUnitM = options.depthUnitM;
+  auto angles = predictEncodingAngles(rig, camera, setup.layout, options.nominalDepthM);
+  if (!angles) {
+    return std::unexpected(angles.error());
+  }
+  setup.predictedAngles = std::move(*angles);
+  for (int p = 0; p < setup.layout.projectors; ++p) {
+    auto tables = buildTriangulationTables(rig, camera, p, options.depthUnitM);
+    if (!tables) {
+      return std::unexpected(tables.error());
+    }
+    setup.triangulation.push_back(std::move(*tables));
+  }
+  return setup;
+}
+
+}  // namespace smx::algo

@@ -1,0 +1,475 @@
+// Multi-layer decoding (stripe_decode.hpp). Numerics:
+//   Positions  Q8 pixels (int32); a boundary lies at its pixel centre + offset (Q8) along the
+//              encoding direction of that pixel, whose unit vector is Q1.14 (demux::UnitTable);
+//              the shift offset·u is rounded half up to Q8 once per frame (|shift| ≤ 128).
+//   Distances  along an axis: dot(ΔQ8, uQ14) >> 14 in int64, so any Δ within the image is exact
+//              before the shift; the shift rounds towards −∞ (≤ 1/256 px).
+//   Walks      half-pixel steps: (u >> 7) in Q8, looking at the 2×2 pixels around each sample.
+//   Coordinate s = level · 2^16 + (dFirst · 2^16) / dBetween, int64, truncated (< 2^-16 stripe);
+//              0 ≤ dFirst < dBetween, so s stays within [level, level + 1) · 2^16.
+#include "smx/algo/stripe_decode.hpp"
+
+#include <array>
+#include <cstdint>
+
+#include "demux_kernels.hpp"
+#include "smx/algo/stripe_code.hpp"
+
+namespace smx::algo {
+
+namespace {
+
+constexpr int kChainEachWay = stripe::kWindowTransitions - 1;  // 5: every window holding a pixel
+constexpr std::int32_t kNone = -1;
+
+struct PointQ8 {
+  std::int32_t x;
+  std::int32_t y;
+};
+
+struct Unit {
+  std::int32_t x;  // Q1.14
+  std::int32_t y;
+};
+
+Unit unitOf(const demux::UnitTable& units, std::uint16_t angle) {
+  return {units.cosOf(angle), units.sinOf(angle)};
+}
+
+// (to − from) · u in Q8 pixels.
+std::int32_t along(PointQ8 from, PointQ8 to, Unit u) {
+  const std::int64_t dot = std::int64_t{to.x - from.x} * u.x + std::int64_t{to.y - from.y} * u.y;
+  return static_cast<std::int32_t>(dot >> 14);
+}
+
+constexpr std::int32_t pack(int x, int y) {
+  return (y << 16) | x;
+}
+constexpr int packedX(std::int32_t p) {
+  return p & 0xFFFF;
+}
+constexpr int packedY(std::int32_t p) {
+  return p >> 16;
+}
+
+Result<void> validate(int width, int height, const DecodeParams& p) {
+  if (width < 1 || height < 1 || width > 8192 || height > 8192) {
+    return fail(Errc::kInvalidArgument, "decode: image size must be 1 to 8192 pixels per side");
+  }
+  if (p.maxGapPx < 1 || p.maxGapPx > 64 || p.minSeparationQ8 < 0 ||
+      p.minSeparationQ8 > 64 * 256 || p.minCurveVotes < 1 || p.minCurveVotes > 1 << 20) {
+    return fail(Errc::kInvalidArgument,
+                "decode: maxGapPx 1 to 64, minSeparationQ8 0 to 16384, minCurveVotes >= 1");
+  }
+  return {};
+}
+
+}  // namespace
+
+template <class Carver>
+Result<void> StripeDecoder::carve(Carver& carver) {
+  const std::size_t pixels = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  Result<void> ok;
+  const auto step = [&ok](Result<void> r) {
+    if (ok && !r) {
+      ok = r;
+    }
+  };
+  step(carveSpan(carver, units_, 1));
+  step(carveSpan(carver, code_, pixels));
+  step(carveSpan(carver, shift_, pixels));
+  step(carveSpan(carver, next_, pixels));
+  step(carveSpan(carver, prev_, pixels));
+  step(carveSpan(carver, parent_, pixels));
+  step(carveSpan(carver, weight_, pixels));
+  step(carveSpan(carver, total_, pixels));
+  step(carveSpan(carver, candidate_, pixels));
+  step(carveSpan(carver, votes_, pixels));
+  step(carveSpan(carver, own_, pixels));
+  step(carveSpan(carver, level_, pixels));
+  return ok;
+}
+
+Result<std::size_t> StripeDecoder::workspaceBytes(int width, int height,
+                                                  const DecodeParams& params) {
+  if (auto ok = validate(width, height, params); !ok) {
+    return std::unexpected(ok.error());
+  }
+  StripeDecoder d;
+  d.width_ = width;
+  d.height_ = height;
+  ArenaSizer sizer;
+  if (auto ok = d.carve(sizer); !ok) {
+    return std::unexpected(ok.error());
+  }
+  return sizer.bytes();
+}
+
+Result<StripeDecoder> StripeDecoder::create(int width, int height, const DecodeParams& params,
+                                            Arena& arena) {
+  if (auto ok = validate(width, height, params); !ok) {
+    return std::unexpected(ok.error());
+  }
+  StripeDecoder d;
+  d.width_ = width;
+  d.height_ = height;
+  d.params_ = params;
+  const Arena::Marker start = arena.mark();
+  if (auto ok = d.carve(arena); !ok) {
+    arena.rewind(start);
+    return std::unexpected(ok.error());
+  }
+  d.units_[0].fill();
+  for (auto& level : d.level_) {
+    level = 0;
+  }
+  return d;
+}
+
+Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPlane directions,
+                                StripePlane stripe) {
+  const auto sameSize = [this](int w, int h) { return w == width_ && h == height_; };
+  if (!sameSize(boundaries.width(), boundaries.height()) ||
+      !sameSize(directions.width(), directions.height()) ||
+      !sameSize(stripe.width(), stripe.height())) {
+    return fail(Errc::kSizeMismatch, "decode: boundary, direction and stripe planes must match");
+  }
+  stats_ = DecodeStats{};
+  prepare(boundaries, directions);
+  link(directions);
+  vote();
+  joinCurves();
+  fill(directions, stripe);
+  return {};
+}
+
+// Each boundary's class and sub-pixel shift in flat planes (the walks below read them many
+// times).
+void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
+  const demux::UnitTable& units = units_[0];
+  for (int y = 0; y < height_; ++y) {
+    const Boundary* row = b.rowPtr(y);
+    const std::uint16_t* dirs = d.rowPtr(y);
+    const auto base = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = base + static_cast<std::size_t>(x);
+      code_[i] = row[x].transition;
+      if (row[x].present()) {
+        const Unit u = unitOf(units, dirs[x]);
+        shift_[i] = {static_cast<std::int16_t>((row[x].offset * u.x + 8192) >> 14),
+                     static_cast<std::int16_t>((row[x].offset * u.y + 8192) >> 14)};
+        ++stats_.boundaryPixels;
+      }
+    }
+  }
+}
+
+namespace {
+
+// Half-pixel steps from `start` along (sx, sy) (Q8 per step), steps first…last; at each step the
+// 2×2 pixels around the sample are looked at (a 1-pixel-thick oblique curve can pass between
+// nearest-pixel samples), each 2×2 block once. `distance(x, y, i)` returns where the boundary
+// at that pixel lies along the walk (Q8), or −1 to pass it over; the nearest accepted pixel of
+// the first block that has one wins, packed (y << 16 | x), else kNone.
+template <class Distance>
+std::int32_t walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start,
+                  std::int32_t sx, std::int32_t sy, int first, int last, Distance distance) {
+  int lastX0 = -2;
+  int lastY0 = -2;
+  for (int k = first; k <= last; ++k) {
+    const int x0 = (start.x + k * sx) >> 8;
+    const int y0 = (start.y + k * sy) >> 8;
+    if (x0 < -1 || y0 < -1 || x0 >= width || y0 >= height) {
+      return kNone;
+    }
+    if (x0 == lastX0 && y0 == lastY0) {
+      continue;
+    }
+    lastX0 = x0;
+    lastY0 = y0;
+    std::int32_t best = kNone;
+    std::int32_t bestDistance = 0;
+    for (int qy = y0; qy <= y0 + 1; ++qy) {
+      for (int qx = x0; qx <= x0 + 1; ++qx) {
+        if (qx < 0 || qy < 0 || qx >= width || qy >= height) {
+          continue;
+        }
+        const std::int32_t i = qy * width + qx;
+        if (code[static_cast<std::size_t>(i)] == 0) {
+          continue;
+        }
+        const std::int32_t dist = distance(qx, qy, i);
+        if (dist >= 0 && (best == kNone || dist < bestDistance)) {
+          best = pack(qx, qy);
+          bestDistance = dist;
+        }
+      }
+    }
+    if (best != kNone) {
+      return best;
+    }
+  }
+  return kNone;
+}
+
+}  // namespace
+
+// Step 1. From the boundary's sub-pixel position, half-pixel steps along ±axis; the first pixel
+// holding a boundary of another class at least minSeparation along the axis is the link
+// (boundaries of the same class met first are the same curve seen on a staircase).
+void StripeDecoder::link(ConstDirectionPlane d) {
+  const demux::UnitTable& units = units_[0];
+  const int steps = 2 * params_.maxGapPx;
+  for (int y = 0; y < height_; ++y) {
+    const std::uint16_t* dirs = d.rowPtr(y);
+    for (int x = 0; x < width_; ++x) {
+      const auto i = static_cast<std::size_t>(y * width_ + x);
+      next_[i] = kNone;
+      prev_[i] = kNone;
+      if (code_[i] == 0) {
+        continue;
+      }
+      const Unit u = unitOf(units, dirs[x]);
+      const PointQ8 p{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
+      for (int sign = -1; sign <= 1; sign += 2) {
+        const auto distance = [&](int qx, int qy, std::int32_t q) -> std::int32_t {
+          const auto qi = static_cast<std::size_t>(q);
+          if (code_[qi] == code_[i]) {
+            return -1;
+          }
+          const PointQ8 qp{qx * 256 + shift_[qi].x, qy * 256 + shift_[qi].y};
+          const std::int32_t dist = sign * along(p, qp, u);
+          return dist >= params_.minSeparationQ8 ? dist : -1;
+        };
+        (sign > 0 ? next_ : prev_)[i] =
+            walk(code_, width_, height_, p, sign * (u.x >> 7), sign * (u.y >> 7), 1, steps,
+                 distance);
+      }
+    }
+  }
+}
+
+// Step 2. The chain around each pixel (index kChainEachWay is the pixel itself), then every
+// window of 6 consecutive transitions in it.
+void StripeDecoder::vote() {
+  const auto indexOf = [this](std::int32_t packed) {
+    return static_cast<std::size_t>(packedY(packed) * width_ + packedX(packed));
+  };
+  const auto kindAt = [this](std::size_t i) {
+    return static_cast<stripe::Transition>(code_[i] - 1);
+  };
+  // A link counts when the linked boundary's own link in the opposite direction comes back to
+  // the same boundary curve (a pixel of the same class), not to some other boundary.
+  const auto linksBack = [&](std::span<const std::int32_t> links, std::size_t from,
+                             std::size_t to) {
+    const std::int32_t back = links[from];
+    return back != kNone && code_[indexOf(back)] == code_[to];
+  };
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    own_[i] = 0;
+    votes_[i] = 0;
+    if (code_[i] == 0) {
+      continue;
+    }
+    std::array<stripe::Transition, 2 * kChainEachWay + 1> chain{};
+    chain[kChainEachWay] = kindAt(i);
+    int lo = kChainEachWay;
+    for (std::size_t cur = i; lo > 0;) {
+      const std::int32_t link = prev_[cur];
+      if (link == kNone) {
+        break;
+      }
+      const std::size_t n = indexOf(link);
+      if (stripe::to(kindAt(n)) != stripe::from(kindAt(cur)) || !linksBack(next_, n, cur)) {
+        break;
+      }
+      chain[static_cast<std::size_t>(--lo)] = kindAt(n);
+      cur = n;
+    }
+    int hi = kChainEachWay;
+    for (std::size_t cur = i; hi < 2 * kChainEachWay;) {
+      const std::int32_t link = next_[cur];
+      if (link == kNone) {
+        break;
+      }
+      const std::size_t n = indexOf(link);
+      if (stripe::from(kindAt(n)) != stripe::to(kindAt(cur)) || !linksBack(prev_, n, cur)) {
+        break;
+      }
+      chain[static_cast<std::size_t>(++hi)] = kindAt(n);
+      cur = n;
+    }
+    // Windows start at j (chain index) with lo ≤ j, j + 5 ≤ hi, j ≤ kChainEachWay ≤ j + 5.
+    std::array<std::int16_t, stripe::kWindowTransitions> found{};
+    int count = 0;
+    for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
+      const int index =
+          stripe::decodeWindow(std::span<const stripe::Transition, stripe::kWindowTransitions>(
+              chain.data() + j, stripe::kWindowTransitions));
+      if (index >= 0) {
+        found[static_cast<std::size_t>(count++)] =
+            static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
+      }
+    }
+    int best = 0;
+    int bestVotes = 0;
+    for (int a = 0; a < count; ++a) {
+      int n = 0;
+      for (int c = 0; c < count; ++c) {
+        n += found[static_cast<std::size_t>(c)] == found[static_cast<std::size_t>(a)] ? 1 : 0;
+      }
+      if (n > bestVotes) {
+        best = found[static_cast<std::size_t>(a)];
+        bestVotes = n;
+      }
+    }
+    // A level only on a strict majority of the pixel's windows.
+    if (2 * bestVotes > count) {
+      own_[i] = static_cast<std::int16_t>(best);
+      votes_[i] = static_cast<std::int16_t>(bestVotes);
+      ++stats_.votedPixels;
+    }
+  }
+}
+
+// Step 3. Union-find over touching boundary pixels of one class (parent = smaller index, path
+// halving), then a weighted Boyer–Moore majority per root and a second pass for its support.
+void StripeDecoder::joinCurves() {
+  const auto find = [this](std::int32_t i) {
+    while (parent_[static_cast<std::size_t>(i)] != i) {
+      const std::int32_t up =
+          parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(i)])];
+      parent_[static_cast<std::size_t>(i)] = up;
+      i = up;
+    }
+    return i;
+  };
+  const auto unite = [&](std::int32_t a, std::int32_t c) {
+    const std::int32_t ra = find(a);
+    const std::int32_t rc = find(c);
+    if (ra < rc) {
+      parent_[static_cast<std::size_t>(rc)] = ra;
+    } else if (rc < ra) {
+      parent_[static_cast<std::size_t>(ra)] = rc;
+    }
+  };
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    parent_[i] = code_[i] != 0 ? static_cast<std::int32_t>(i) : kNone;
+    weight_[i] = 0;
+    total_[i] = 0;
+    candidate_[i] = 0;
+  }
+  if (params_.curves) {
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        const std::int32_t i = y * width_ + x;
+        const std::uint8_t t = code_[static_cast<std::size_t>(i)];
+        if (t == 0) {
+          continue;
+        }
+        if (x + 1 < width_ && code_[static_cast<std::size_t>(i + 1)] == t) {
+          unite(i, i + 1);
+        }
+        if (y + 1 == height_) {
+          continue;
+        }
+        for (int dx = -1; dx <= 1; ++dx) {
+          const std::int32_t below = i + width_ + dx;
+          if (x + dx >= 0 && x + dx < width_ && code_[static_cast<std::size_t>(below)] == t) {
+            unite(i, below);
+          }
+        }
+      }
+    }
+  }
+  // Majority candidate per root, then its support among all votes of the curve.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t i = 0; i < code_.size(); ++i) {
+      const std::int32_t v = votes_[i];
+      if (v == 0) {
+        continue;
+      }
+      const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+      if (pass == 0) {
+        if (candidate_[r] == own_[i]) {
+          weight_[r] += v;
+        } else if (weight_[r] >= v) {
+          weight_[r] -= v;
+        } else {
+          candidate_[r] = own_[i];
+          weight_[r] = v - weight_[r];
+        }
+      } else {
+        total_[r] += v;
+        weight_[r] += candidate_[r] == own_[i] ? v : 0;
+      }
+    }
+    if (pass == 0) {
+      for (auto& w : weight_) {
+        w = 0;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    level_[i] = 0;
+    if (code_[i] == 0) {
+      continue;
+    }
+    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    const bool majority = 2 * weight_[r] > total_[r] && weight_[r] >= params_.minCurveVotes;
+    if (r == i && majority) {
+      ++stats_.curves;
+    }
+    if (majority && (own_[i] == candidate_[r] || votes_[i] < 2)) {
+      level_[i] = candidate_[r];
+      ++stats_.decodedPixels;
+    }
+  }
+}
+
+// Step 4. Walk back along the pixel's own axis to the nearest boundary at or behind it; the
+// pixel lies between that boundary and its forward link when their levels are consecutive.
+void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
+  const demux::UnitTable& units = units_[0];
+  const int steps = 2 * params_.maxGapPx;
+  const auto positionOf = [this](int x, int y) {
+    const Shift s = shift_[static_cast<std::size_t>(y * width_ + x)];
+    return PointQ8{x * 256 + s.x, y * 256 + s.y};
+  };
+  for (int y = 0; y < height_; ++y) {
+    StripeQ16* out = stripe.rowPtr(y);
+    const std::uint16_t* dirs = d.rowPtr(y);
+    for (int x = 0; x < width_; ++x) {
+      out[x] = kNoStripe;
+      const Unit u = unitOf(units, dirs[x]);
+      const PointQ8 here{x * 256, y * 256};
+      const auto behind = [&](int qx, int qy, std::int32_t) {
+        return along(positionOf(qx, qy), here, u);
+      };
+      const std::int32_t q =
+          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind);
+      if (q == kNone) {
+        continue;
+      }
+      const int qx = packedX(q);
+      const int qy = packedY(q);
+      const std::size_t qi = static_cast<std::size_t>(qy * width_ + qx);
+      const std::int32_t level = level_[qi];
+      const std::int32_t n = next_[qi];
+      if (level == 0 || n == kNone ||
+          level_[static_cast<std::size_t>(packedY(n) * width_ + packedX(n))] != level + 1) {
+        continue;
+      }
+      const std::int32_t first = along(positionOf(qx, qy), here, u);
+      const std::int32_t between = first - along(positionOf(packedX(n), packedY(n)), here, u);
+      if (first >= between) {
+        continue;  // the pixel lies beyond the forward link
+      }
+      out[x] = static_cast<StripeQ16>(std::int64_t{level} * kStripeOne +
+                                      std::int64_t{first} * kStripeOne / between);
+      ++stats_.densePixels;
+    }
+  }
+}
+
+}  // namespace smx::algo

@@ -1,0 +1,67 @@
+// Triangulation per frame (triangulation.hpp): the tables copied into the arena at create(),
+// one integer division per pixel.
+#include <cstdint>
+
+#include "smx/algo/triangulation.hpp"
+
+namespace smx::algo {
+
+Result<std::size_t> Triangulator::workspaceBytes(int width, int height) {
+  if (width < 1 || height < 1 || width > 8192 || height > 8192) {
+    return fail(Errc::kInvalidArgument, "triangulation: image size must be 1 to 8192 per side");
+  }
+  const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  ArenaSizer sizer;
+  (void)sizer.allocate<std::int32_t>(pixels);
+  (void)sizer.allocate<std::int32_t>(pixels);
+  (void)sizer.allocate<std::int8_t>(pixels);
+  return sizer.bytes();
+}
+
+Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Arena& arena) {
+  if (auto bytes = workspaceBytes(tables.width, tables.height); !bytes) {
+    return std::unexpected(bytes.error());
+  }
+  const auto pixels = static_cast<std::size_t>(tables.width) *
+                      static_cast<std::size_t>(tables.height);
+  if (tables.denominatorBase.size() != pixels || tables.denominatorSlope.size() != pixels ||
+      tables.sense.size() != pixels) {
+    return fail(Errc::kSizeMismatch, "triangulation: tables must hold width x height entries");
+  }
+  Triangulator t;
+  t.width_ = tables.width;
+  t.height_ = tables.height;
+  t.numeratorBase_ = tables.numeratorBase;
+  t.numeratorSlope_ = tables.numeratorSlope;
+  const Arena::Marker start = arena.mark();
+  Result<void> ok = carveSpan(arena, t.base_, pixels);
+  ok = ok ? carveSpan(arena, t.slope_, pixels) : ok;
+  ok = ok ? carveSpan(arena, t.sense_, pixels) : ok;
+  if (!ok) {
+    arena.rewind(start);
+    return std::unexpected(ok.error());
+  }
+  for (std::size_t i = 0; i < pixels; ++i) {
+    t.base_[i] = tables.denominatorBase[i];
+    t.slope_[i] = tables.denominatorSlope[i];
+    t.sense_[i] = tables.sense[i];
+  }
+  return t;
+}
+
+Result<void> Triangulator::run(ConstStripePlane stripe, DepthPlane depth) const {
+  if (stripe.width() != width_ || stripe.height() != height_ || depth.width() != width_ ||
+      depth.height() != height_) {
+    return fail(Errc::kSizeMismatch, "triangulation: stripe and depth planes must match the tables");
+  }
+  for (int y = 0; y < height_; ++y) {
+    const StripeQ16* s = stripe.rowPtr(y);
+    std::uint16_t* z = depth.rowPtr(y);
+    for (int x = 0; x < width_; ++x) {
+      z[x] = depthAt(x, y, s[x]);
+    }
+  }
+  return {};
+}
+
+}  // namespace smx::algo

@@ -1,0 +1,50 @@
+#include "camera_images.hpp"
+
+#include <optional>
+
+namespace smx::host {
+
+std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
+    const std::vector<std::string>& specs, const algo::Rig& rig) {
+  std::vector<CameraImage> out;
+  for (const auto& spec : specs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
+      return std::unexpected("--image " + spec + ": expected CAMERA=FILE, e.g. cam0=frame.png");
+    }
+    const std::string id = spec.substr(0, eq);
+    std::optional<std::size_t> index;
+    std::string known;
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      index = rig.cameras[c].id == id ? std::optional(c) : index;
+      known += (known.empty() ? "" : ", ") + rig.cameras[c].id;
+    }
+    if (!index) {
+      std::string message = "--image " + spec;
+      message += ": the rig has no camera \"";
+      message += id;
+      message += "\" (cameras: ";
+      message += known;
+      message += ")";
+      return std::unexpected(message);
+    }
+    out.push_back({*index, spec.substr(eq + 1)});
+  }
+  return out;
+}
+
+std::expected<sim::RgbImage, std::string> readCameraImage(const std::filesystem::path& file,
+                                                          const algo::Camera& camera) {
+  auto image = sim::readPngRgb8(file);
+  if (!image) {
+    return std::unexpected(image.error());
+  }
+  if (image->width != camera.width || image->height != camera.height) {
+    return std::unexpected(file.string() + ": image is " + std::to_string(image->width) + "x" +
+                           std::to_string(image->height) + ", camera " + camera.id + " is " +
+                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  return image;
+}
+
+}  // namespace smx::host

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <cstddef>
+#include <expected>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "smx/algo/rig.hpp"
+#include "smx/sim/png_io.hpp"
+
+// `--image CAM=FILE` arguments shared by the commands that take camera images.
+namespace smx::host {
+
+struct CameraImage {
+  std::size_t camera;  // index into rig.cameras
+  std::filesystem::path file;
+};
+
+// Each spec must be CAMERA=FILE with a camera id of the rig; errors name the spec and list the
+// rig's cameras.
+[[nodiscard]] std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
+    const std::vector<std::string>& specs, const algo::Rig& rig);
+
+// Reads the PNG and checks it has the camera's size; errors name the file.
+[[nodiscard]] std::expected<sim::RgbImage, std::string> readCameraImage(
+    const std::filesystem::path& file, const algo::Camera& camera);
+
+}  // namespace smx::host

@@ -1,0 +1,262 @@
+// stripemux decode --rig rig.json --image CAM=FILE [--image CAM=FILE ...] --out DIR
+//                  [--debug DIR2] [--nominal-depth M] [--depth-unit M]
+// The whole offline pipeline on camera images: demultiplexing, decoding, triangulation, merging;
+// range images, point clouds and meta.json (docs/cli.md, docs/decode.md).
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "camera_images.hpp"
+#include "commands.hpp"
+#include "decode_debug.hpp"
+#include "demux_debug.hpp"
+#include "point_cloud.hpp"
+#include "smx/algo/camera_pipeline.hpp"
+#include "smx/protocol/rig_json.hpp"
+#include "smx/sim/ply_io.hpp"
+#include "smx/sim/png_io.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+struct DecodeOptions {
+  fs::path rig;
+  std::vector<std::string> images;  // CAM=FILE
+  fs::path out;
+  std::optional<fs::path> debug;
+  double nominalDepthM = 0.9;
+  double depthUnitM = algo::kDefaultDepthUnitM;
+};
+
+// A failure with its exit code and message.
+struct Failure {
+  int code;
+  std::string message;
+};
+
+int countValid(algo::ConstDepthPlane depth) {
+  int n = 0;
+  for (int y = 0; y < depth.height(); ++y) {
+    for (int x = 0; x < depth.width(); ++x) {
+      n += depth(x, y) != algo::kNoDepth ? 1 : 0;
+    }
+  }
+  return n;
+}
+
+std::expected<void, Failure> writeOrFail(const std::expected<void, std::string>& written) {
+  if (!written) {
+    return std::unexpected(Failure{kExitDeviceOrIo, written.error()});
+  }
+  return {};
+}
+
+std::expected<void, Failure> writeDebug(const fs::path& dir, const algo::Camera& camera,
+                                        const algo::Rig& rig, algo::CameraPipeline& pipeline) {
+  for (int p = 0; p < pipeline.projectors(); ++p) {
+    const std::string tag = rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id;
+    if (auto ok = pipeline.demux().separateOnly(p); !ok) {
+      return std::unexpected(Failure{kExitBadInput, ok.error().message});
+    }
+    if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
+      return ok;
+    }
+    if (auto ok = writeOrFail(sim::writePngRgb8(dir / (tag + ".stripes.png"),
+                                                renderStripes(pipeline.stripe(p)).view()));
+        !ok) {
+      return ok;
+    }
+    if (auto ok = writeOrFail(sim::writePngRgb8(dir / (tag + ".depth.png"),
+                                                renderDepth(pipeline.depth(p)).view()));
+        !ok) {
+      return ok;
+    }
+  }
+  return writeOrFail(sim::writePngRgb8(dir / (camera.id + ".depth.png"),
+                                       renderDepth(pipeline.merged()).view()));
+}
+
+struct CameraResult {
+  Json meta;
+  std::vector<sim::PlyPoint> points;
+};
+
+std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
+                                                  const CameraImage& input,
+                                                  const CliStreams& io) {
+  const algo::Camera& camera = rig.cameras[input.camera];
+  const auto image = readCameraImage(input.file, camera);
+  if (!image) {
+    return std::unexpected(Failure{kExitBadInput, image.error()});
+  }
+  algo::PipelineOptions options;
+  options.nominalDepthM = opts.nominalDepthM;
+  options.depthUnitM = opts.depthUnitM;
+  const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(input.camera), options);
+  if (!setup) {
+    return std::unexpected(Failure{kExitBadInput, opts.rig.string() + ": " + setup.error()});
+  }
+  const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
+  if (!bytes) {
+    return std::unexpected(Failure{kExitBadInput, std::string("pipeline: ") + bytes.error().message});
+  }
+  std::vector<std::byte> memory(*bytes);
+  algo::Arena arena(memory);
+  auto pipeline = algo::CameraPipeline::create(*setup, arena);
+  if (!pipeline) {
+    return std::unexpected(
+        Failure{kExitBadInput, std::string("pipeline: ") + pipeline.error().message});
+  }
+
+  // The stages one by one, timed.
+  Json timings = Json::object();
+  double totalMs = 0;
+  const auto timed = [&](const char* name, auto&& stage) -> algo::Result<void> {
+    const auto start = std::chrono::steady_clock::now();
+    auto ok = stage();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    timings[name] = ms;
+    totalMs += ms;
+    return ok;
+  };
+  algo::Result<void> ok = timed("demux", [&] { return pipeline->demultiplex(image->view()); });
+  ok = ok ? timed("decode", [&] { return pipeline->decode(); }) : ok;
+  ok = ok ? timed("triangulate", [&] { return pipeline->triangulate(); }) : ok;
+  ok = ok ? timed("merge", [&] { return pipeline->merge(); }) : ok;
+  if (!ok) {
+    return std::unexpected(Failure{kExitBadInput, input.file.string() + ": " + ok.error().message});
+  }
+  timings["total"] = totalMs;
+
+  CameraResult result;
+  Json pairs = Json::array();
+  for (int p = 0; p < pipeline->projectors(); ++p) {
+    const std::string name =
+        rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id + ".depth.png";
+    if (auto w = writeOrFail(sim::writePngGray16(opts.out / name, pipeline->depth(p))); !w) {
+      return std::unexpected(w.error());
+    }
+    const algo::DecodeStats& stats = pipeline->decodeStats(p);
+    pairs.push_back({{"projector", rig.projectors[static_cast<std::size_t>(p)].id},
+                     {"depth", name},
+                     {"valid_pixels", countValid(pipeline->depth(p))},
+                     {"boundary_pixels", stats.boundaryPixels},
+                     {"decoded_boundary_pixels", stats.decodedPixels}});
+  }
+  const std::string depthName = camera.id + ".depth.png";
+  if (auto w = writeOrFail(sim::writePngGray16(opts.out / depthName, pipeline->merged())); !w) {
+    return std::unexpected(w.error());
+  }
+  result.points = depthToWorldPoints(camera, pipeline->merged(), opts.depthUnitM, image->view());
+  const std::string plyName = camera.id + ".ply";
+  if (auto w = writeOrFail(sim::writePlyPoints(opts.out / plyName, result.points)); !w) {
+    return std::unexpected(w.error());
+  }
+  if (opts.debug) {
+    if (auto w = writeDebug(*opts.debug, camera, rig, *pipeline); !w) {
+      return std::unexpected(w.error());
+    }
+  }
+  const int valid = countValid(pipeline->merged());
+  io.out << camera.id << " (" << input.file.string() << "): " << valid << " depth pixels ("
+         << (100 * valid) / (camera.width * camera.height) << " % of the image) in "
+         << static_cast<int>(totalMs) << " ms, " << *bytes / 1024 << " KiB working memory\n";
+  for (const auto& pair : pairs) {
+    io.out << "  " << pair["projector"].get<std::string>() << ": "
+           << pair["valid_pixels"].get<int>() << " depth pixels\n";
+  }
+  result.meta = {{"id", camera.id},
+                 {"image", input.file.string()},
+                 {"width", camera.width},
+                 {"height", camera.height},
+                 {"depth", depthName},
+                 {"ply", plyName},
+                 {"valid_pixels", valid},
+                 {"working_memory_bytes", *bytes},
+                 {"timings_ms", timings},
+                 {"pairs", pairs}};
+  return result;
+}
+
+int runDecode(const DecodeOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux decode: " << message << "\n";
+    return code;
+  };
+  const auto rig = protocol::loadRig(opts.rig);
+  if (!rig) {
+    return fail(kExitBadInput, rig.error().message());
+  }
+  const auto images = parseCameraImages(opts.images, *rig);
+  if (!images) {
+    return fail(kExitBadInput, images.error());
+  }
+  for (const auto& dir : {std::optional(opts.out), opts.debug}) {
+    std::error_code ec;
+    if (dir && (fs::create_directories(*dir, ec), ec)) {
+      return fail(kExitDeviceOrIo, "cannot create directory " + dir->string() + ": " + ec.message());
+    }
+  }
+  Json cameras = Json::array();
+  std::vector<sim::PlyPoint> merged;
+  for (const CameraImage& input : *images) {
+    auto result = decodeCamera(opts, *rig, input, io);
+    if (!result) {
+      return fail(result.error().code, result.error().message);
+    }
+    cameras.push_back(result->meta);
+    merged.insert(merged.end(), result->points.begin(), result->points.end());
+  }
+  if (auto ok = sim::writePlyPoints(opts.out / "merged.ply", merged); !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
+  }
+  const Json meta = {{"format", "stripemux-decode/1"},
+                     {"depth_unit_m", opts.depthUnitM},
+                     {"rig", opts.rig.string()},
+                     {"cameras", cameras},
+                     {"merged_ply", "merged.ply"},
+                     {"merged_points", merged.size()}};
+  std::ofstream file(opts.out / "meta.json");
+  file << meta.dump(2) << "\n";
+  if (!file) {
+    return fail(kExitDeviceOrIo, "cannot write " + (opts.out / "meta.json").string());
+  }
+  io.out << "wrote " << (opts.out / "merged.ply").string() << " (" << merged.size()
+         << " points) and " << (opts.out / "meta.json").string() << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<DecodeOptions>();
+  auto* cmd = app.add_subcommand(
+      "decode", "Range images and point clouds from camera images: the whole offline pipeline");
+  cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
+  cmd->add_option("--image", opts->images, "CAMERA=FILE: a camera's image (PNG), repeatable")
+      ->required();
+  cmd->add_option("--out", opts->out, "Output directory: depth PNGs, PLY point clouds, meta.json")
+      ->required();
+  cmd->add_option("--debug", opts->debug,
+                  "Write per projector and camera: stripe segmentation, decoded stripes, depth");
+  cmd->add_option("--nominal-depth", opts->nominalDepthM,
+                  "Depth (m) at which the rig predicts the pattern directions")
+      ->check(CLI::Range(0.05, 100.0));
+  cmd->add_option("--depth-unit", opts->depthUnitM,
+                  "Metres per unit of the 16-bit depth images (default 0.0001)")
+      ->check(CLI::Range(1e-6, 0.01));
+  cmd->callback([opts, &io, &exitCode] { exitCode = runDecode(*opts, io); });
+}
+
+}  // namespace smx::host
