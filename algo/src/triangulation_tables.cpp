@@ -27,13 +27,13 @@ double dot(const Vec3& a, const Vec3& b) {
 // a · bᵀ for rotations: (R_p · R_cᵀ).
 Mat3 mulTransposed(const Mat3& a, const Mat3& b) {
   Mat3 out{};
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
+  for (std::size_t r = 0; r < 3; ++r) {
+    for (std::size_t c = 0; c < 3; ++c) {
       double v = 0;
-      for (int k = 0; k < 3; ++k) {
-        v += a[static_cast<std::size_t>(r * 3 + k)] * b[static_cast<std::size_t>(c * 3 + k)];
+      for (std::size_t k = 0; k < 3; ++k) {
+        v += a[r * 3 + k] * b[c * 3 + k];
       }
-      out[static_cast<std::size_t>(r * 3 + c)] = v;
+      out[r * 3 + c] = v;
     }
   }
   return out;
@@ -47,8 +47,7 @@ double baselineM(const Rig& rig, int camera, int projector) {
   return std::hypot(c[0] - p[0], c[1] - p[1], c[2] - p[2]);
 }
 
-std::expected<TriangulationTables, std::string> buildTriangulationTables(const Rig& rig,
-                                                                         int camera,
+std::expected<TriangulationTables, std::string> buildTriangulationTables(const Rig& rig, int camera,
                                                                          int projector,
                                                                          double depthUnitM) {
   if (camera < 0 || camera >= static_cast<int>(rig.cameras.size())) {
@@ -94,7 +93,8 @@ std::expected<TriangulationTables, std::string> buildTriangulationTables(const R
   double largest = 0.0;
   for (int y = 0; y < cam.height; ++y) {
     for (int x = 0; x < cam.width; ++x) {
-      const auto n = lens::undistort(cam.dist, {(x - cam.cx()) / cam.fx(), (y - cam.cy()) / cam.fy()});
+      const auto n =
+          lens::undistort(cam.dist, {(x - cam.cx()) / cam.fx(), (y - cam.cy()) / cam.fy()});
       if (!n) {
         continue;
       }

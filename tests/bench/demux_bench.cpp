@@ -17,8 +17,8 @@
 //                      separate and boundaries cover all projectors. Before timing, the stage
 //                      chain is run once and its boundaries and directions are checked equal to
 //                      run()'s.
-//   <cfg>/pipeline     CameraPipeline::run(): demux, decode, triangulate and merge (docs/decode.md);
-//   <cfg>/p_decode, p_triangulate, p_merge
+//   <cfg>/pipeline     CameraPipeline::run(): demux, decode, triangulate and merge
+//   (docs/decode.md); <cfg>/p_decode, p_triangulate, p_merge
 //                      those stages alone, on the output of the pipeline's last run.
 // Counters: px/s (frame pixels per CPU second); x_sobel = this benchmark's CPU time per frame /
 // one Sobel's CPU time measured at start-up (the mean of kSobelCalls calls after kSobelWarmUp
@@ -394,19 +394,17 @@ void timeFrames(benchmark::State& state, const Config& c, std::size_t arenaBytes
   const auto frames = static_cast<double>(state.iterations());
   state.counters["px/s"] = benchmark::Counter(c.pixels() * frames, benchmark::Counter::kIsRate);
   state.counters["x_sobel"] = frames > 0 ? seconds / frames / c.sobelSecondsPerCall : 0.0;
-  state.counters["arena"] =
-      benchmark::Counter(static_cast<double>(arenaBytes), benchmark::Counter::kDefaults,
-                         benchmark::Counter::kIs1024);
+  state.counters["arena"] = benchmark::Counter(
+      static_cast<double>(arenaBytes), benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
 }
 
 // Registers <cfg>/sobel, <cfg>/demux and the stages; c outlives the benchmarks.
 void registerConfig(Config* c) {
   const auto addWith = [c](const std::string& what, std::size_t arenaBytes, auto body) {
-    benchmark::RegisterBenchmark((c->name + "/" + what).c_str(),
-                                 [c, arenaBytes, body](benchmark::State& s) {
-                                   timeFrames(s, *c, arenaBytes, body);
-                                 })
-        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark((c->name + "/" + what).c_str(), [c, arenaBytes,
+                                                                  body](benchmark::State& s) {
+      timeFrames(s, *c, arenaBytes, body);
+    })->Unit(benchmark::kMillisecond);
   };
   const auto add = [c, addWith](const std::string& what, auto body) {
     addWith(what, c->arenaBytes, body);

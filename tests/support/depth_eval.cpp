@@ -22,7 +22,8 @@ bool isGrossError(double zM, double zTruthM) {
 }
 
 DepthScore scoreDepth(algo::ConstDepthPlane depth, algo::ImageView<const float> truthDepth,
-                      algo::ImageView<const std::uint8_t> region, const DepthScoreOptions& options) {
+                      algo::ImageView<const std::uint8_t> region,
+                      const DepthScoreOptions& options) {
   requireSameSize(depth, truthDepth);
   requireSameSize(depth, region);
   DepthScore s;

@@ -65,10 +65,9 @@ TEST_F(CliDecode, WritesDepthPointCloudsAndMetaThatMatchTheTruth) {
   const auto in = frames();
   const auto out = dir_ / "out";
   const auto debug = dir_ / "debug";
-  const auto result =
-      test::runCli({"decode", "--rig", kRig2Cam, "--image", "cam0=" + (in / "cam0.png").string(),
-                    "--image", "cam1=" + (in / "cam1.png").string(), "--out", out.string(),
-                    "--debug", debug.string()});
+  const auto result = test::runCli(
+      {"decode", "--rig", kRig2Cam, "--image", "cam0=" + (in / "cam0.png").string(), "--image",
+       "cam1=" + (in / "cam1.png").string(), "--out", out.string(), "--debug", debug.string()});
   ASSERT_EQ(result.code, kExitOk) << result.err;
 
   std::ifstream metaFile(out / "meta.json");
@@ -116,14 +115,13 @@ TEST_F(CliDecode, WritesDepthPointCloudsAndMetaThatMatchTheTruth) {
 TEST_F(CliDecode, BadImagesAndCamerasExitTwoNamingThem) {
   const auto in = frames();
   const auto out = (dir_ / "out").string();
-  const auto unknown =
-      test::runCli({"decode", "--rig", kRig2Cam, "--image", "cam7=" + (in / "cam0.png").string(),
-                    "--out", out});
+  const auto unknown = test::runCli(
+      {"decode", "--rig", kRig2Cam, "--image", "cam7=" + (in / "cam0.png").string(), "--out", out});
   EXPECT_EQ(unknown.code, kExitBadInput);
   EXPECT_NE(unknown.err.find("cam7"), std::string::npos) << unknown.err;
 
-  const auto missing = test::runCli(
-      {"decode", "--rig", kRig2Cam, "--image", "cam0=" + (dir_ / "nope.png").string(), "--out", out});
+  const auto missing = test::runCli({"decode", "--rig", kRig2Cam, "--image",
+                                     "cam0=" + (dir_ / "nope.png").string(), "--out", out});
   EXPECT_EQ(missing.code, kExitBadInput);
   EXPECT_NE(missing.err.find("nope.png"), std::string::npos) << missing.err;
 

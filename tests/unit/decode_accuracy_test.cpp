@@ -68,7 +68,8 @@ test::Mask region(const test::SimFrame& f, int n, bool exactly, bool smooth, int
   if (p >= 0) {
     for (int y = 0; y < m.height; ++y) {
       for (int x = 0; x < m.width; ++x) {
-        m.at(x, y) = (m.at(x, y) != 0 && f.lit[static_cast<std::size_t>(p)].at(x, y) != 0) ? 255 : 0;
+        m.at(x, y) =
+            (m.at(x, y) != 0 && f.lit[static_cast<std::size_t>(p)].at(x, y) != 0) ? 255 : 0;
       }
     }
   }
@@ -105,10 +106,10 @@ void print(const std::string& what, const test::DepthScore& s) {
 }
 
 struct SceneFigures {
-  test::DepthScore mergedAll;     // lit by ≥ 1, every pixel
-  test::DepthScore mergedSmooth;  // lit by ≥ 1, smooth interior
-  test::DepthScore merged2;       // lit by exactly 2, smooth interior
-  test::DepthScore merged3;       // lit by exactly 3, smooth interior
+  test::DepthScore mergedAll;           // lit by ≥ 1, every pixel
+  test::DepthScore mergedSmooth;        // lit by ≥ 1, smooth interior
+  test::DepthScore merged2;             // lit by exactly 2, smooth interior
+  test::DepthScore merged3;             // lit by exactly 3, smooth interior
   std::vector<test::DepthScore> pairs;  // each projector where it lights the surface, smooth
 };
 

@@ -1,13 +1,17 @@
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "smx/sim/pfm_io.hpp"
+#include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
 
 namespace smx::sim {
@@ -90,6 +94,130 @@ TEST(SimIo, GreyAndRgbPngRoundTrip) {
   EXPECT_EQ(back->pixels[3], (algo::Rgb8{250, 251, 252}));
   EXPECT_FALSE(readPngRgb8(tempFile("missing.png")).has_value());
   fs::remove(rgbPath);
+}
+
+// The raw samples of a 1×1 16-bit PNG: the zlib stream of its IDAT chunks inflated by hand is
+// [filter byte][high byte][low byte] (for a single pixel every PNG filter leaves the bytes as
+// they are), so the stored value is checked independently of libpng's reader.
+std::vector<std::uint8_t> rawSamplesOfOnePixelPng(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::uint8_t> file((std::istreambuf_iterator<char>(in)), {});
+  std::vector<std::uint8_t> idat;
+  std::uint8_t bitDepth = 0;
+  std::uint8_t colourType = 255;
+  for (std::size_t at = 8; at + 12 <= file.size();) {
+    const std::size_t length = (std::size_t{file[at]} << 24) | (std::size_t{file[at + 1]} << 16) |
+                               (std::size_t{file[at + 2]} << 8) | file[at + 3];
+    const std::string type(reinterpret_cast<const char*>(&file[at + 4]), 4);
+    if (type == "IHDR") {
+      bitDepth = file[at + 8 + 8];
+      colourType = file[at + 8 + 9];
+    } else if (type == "IDAT") {
+      idat.insert(idat.end(), file.begin() + static_cast<std::ptrdiff_t>(at + 8),
+                  file.begin() + static_cast<std::ptrdiff_t>(at + 8 + length));
+    }
+    at += 12 + length;
+  }
+  EXPECT_EQ(bitDepth, 16);
+  EXPECT_EQ(colourType, 0);  // greyscale
+  std::vector<std::uint8_t> raw(16);
+  uLongf size = raw.size();
+  EXPECT_EQ(uncompress(raw.data(), &size, idat.data(), idat.size()), Z_OK);
+  raw.resize(size);
+  return raw;
+}
+
+// Given depth values, when written as a 16-bit grey PNG, then they read back exactly, and the
+// file stores them big-endian without a gamma conversion (what OpenCV and Open3D read).
+TEST(SimIo, Gray16PngStoresTheValuesExactly) {
+  std::vector<std::uint16_t> depth = {0, 1, 9000, 65535, 0x1234, 300};
+  const auto path = tempFile("depth.png");
+  ASSERT_TRUE(writePngGray16(path, *algo::ImageView<const std::uint16_t>::packed(depth, 3, 2)));
+  const auto back = readPngGray16(path);
+  ASSERT_TRUE(back.has_value()) << back.error();
+  EXPECT_EQ(back->width, 3);
+  EXPECT_EQ(back->height, 2);
+  EXPECT_EQ(back->pixels, depth);
+
+  std::vector<std::uint16_t> one = {0x1234};
+  const auto onePath = tempFile("one.png");
+  ASSERT_TRUE(writePngGray16(onePath, *algo::ImageView<const std::uint16_t>::packed(one, 1, 1)));
+  const auto raw = rawSamplesOfOnePixelPng(onePath);
+  ASSERT_EQ(raw.size(), 3U);
+  EXPECT_EQ(raw[1], 0x12);
+  EXPECT_EQ(raw[2], 0x34);
+  fs::remove(path);
+  fs::remove(onePath);
+}
+
+TEST(SimIo, Gray16ReaderNamesOtherKindsOfPng) {
+  std::vector<std::uint8_t> mask = {0, 255};
+  const auto path = tempFile("grey8.png");
+  ASSERT_TRUE(writePngGray8(path, *algo::ImageView<const std::uint8_t>::packed(mask, 2, 1)));
+  const auto r = readPngGray16(path);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.error().find("grey8.png"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("8-bit"), std::string::npos) << r.error();
+  fs::remove(path);
+}
+
+// Given points, when written as PLY, then the header is the documented one and the points
+// read back exactly.
+TEST(SimIo, PlyPointsRoundTripWithTheDocumentedHeader) {
+  const std::vector<PlyPoint> points = {{0.1F, -0.2F, 0.9F, 255, 0, 7},
+                                        {1e-3F, 2.5F, 3.25F, 1, 2, 3}};
+  const auto path = tempFile("cloud.ply");
+  ASSERT_TRUE(writePlyPoints(path, points));
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment stripemux range output, metres\n"
+      "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  ASSERT_EQ(text.substr(0, header.size()), header);
+  EXPECT_EQ(text.size(), header.size() + 2 * 15);
+  float x = 0;
+  std::memcpy(&x, text.data() + header.size(), 4);
+  EXPECT_EQ(x, 0.1F);
+  const auto back = readPlyPoints(path);
+  ASSERT_TRUE(back.has_value()) << back.error();
+  ASSERT_EQ(back->size(), 2U);
+  EXPECT_EQ((*back)[1].z, 3.25F);
+  EXPECT_EQ((*back)[0].r, 255);
+  EXPECT_EQ((*back)[0].b, 7);
+  fs::remove(path);
+}
+
+TEST(SimIo, PlyReaderAcceptsAsciiAndRejectsTruncatedOrForeignFiles) {
+  const auto ascii = tempFile("ascii.ply");
+  std::ofstream(ascii) << "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                          "property float y\nproperty float z\nend_header\n1 2 3\n4 5 6\n";
+  const auto a = readPlyPoints(ascii);
+  ASSERT_TRUE(a.has_value()) << a.error();
+  EXPECT_EQ((*a)[1].y, 5.0F);
+
+  const std::vector<PlyPoint> points(10);
+  const auto cut = tempFile("cut.ply");
+  ASSERT_TRUE(writePlyPoints(cut, points));
+  fs::resize_file(cut, fs::file_size(cut) - 20);
+  const auto truncated = readPlyPoints(cut);
+  ASSERT_FALSE(truncated.has_value());
+  EXPECT_NE(truncated.error().find("truncated"), std::string::npos) << truncated.error();
+
+  // A corrupt vertex count must be rejected before anything is allocated for it.
+  const auto huge = tempFile("huge.ply");
+  std::ofstream(huge) << "ply\nformat binary_little_endian 1.0\nelement vertex 999999999999\n"
+                         "property float x\nproperty float y\nproperty float z\nend_header\n";
+  EXPECT_FALSE(readPlyPoints(huge).has_value());
+
+  const auto mesh = tempFile("mesh.ply");
+  std::ofstream(mesh) << "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
+                         "property float y\nproperty float z\nelement face 0\nend_header\n";
+  EXPECT_FALSE(readPlyPoints(mesh).has_value());
+  EXPECT_FALSE(readPlyPoints(tempFile("missing.ply")).has_value());
+  for (const auto& p : {ascii, cut, huge, mesh}) {
+    fs::remove(p);
+  }
 }
 
 }  // namespace

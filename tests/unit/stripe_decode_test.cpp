@@ -47,9 +47,9 @@ struct Synthetic {
         }
         Boundary& b = at(x, y);
         b.offset = static_cast<std::int16_t>(std::lround(deltaPx * 256));
-        b.transition = Boundary::code(stripe::transitionBetween(
-            stripe::kSequence[static_cast<std::size_t>(k - 1)],
-            stripe::kSequence[static_cast<std::size_t>(k)]));
+        b.transition = Boundary::code(
+            stripe::transitionBetween(stripe::kSequence[static_cast<std::size_t>(k - 1)],
+                                      stripe::kSequence[static_cast<std::size_t>(k)]));
         b.confidence = 255;
       }
     }
@@ -134,7 +134,8 @@ TEST(StripeDecode, CleanPatternGivesTheExactCoordinateEverywhereBetweenDecodable
         for (int x = 20; x < 70; ++x) {
           const auto i = static_cast<std::size_t>(y * syn.width + x);
           char c = d.stripe[i] == kNoStripe ? '.' : 'o';
-          if (syn.at(x, y).present()) c = d.levels[i] != 0 ? 'B' : 'b';
+          if (syn.at(x, y).present())
+            c = d.levels[i] != 0 ? 'B' : 'b';
           std::putchar(c);
         }
         std::putchar('\n');

@@ -72,8 +72,8 @@ Errors triangulateTruth(const test::SimFrame& f, int camera, int projector) {
 TEST(TriangulationSim, TruthStripeGivesTruthDepth) {
   for (const char* scene : {"plane", "sphere"}) {
     for (int camera = 0; camera < 2; ++camera) {
-      const auto f = test::renderSimFrame({.rigFile = "rig_2proj_2cam.json", .scene = scene,
-                                           .camera = camera});
+      const auto f = test::renderSimFrame(
+          {.rigFile = "rig_2proj_2cam.json", .scene = scene, .camera = camera});
       for (int p = 0; p < 2; ++p) {
         const Errors e = triangulateTruth(f, camera, p);
         std::printf("%-7s cam%d proj%d: %d px, rms %.3f max %.3f units, %d missing\n", scene,

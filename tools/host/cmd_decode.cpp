@@ -76,24 +76,21 @@ std::expected<void, Failure> writeDebug(const fs::path& dir, const algo::Camera&
         !ok) {
       return ok;
     }
-    if (auto ok = writeOrFail(sim::writePngRgb8(dir / (tag + ".depth.png"),
-                                                renderDepth(pipeline.depth(p)).view()));
+    if (auto ok = writeOrFail(
+            sim::writePngRgb8(dir / (tag + ".depth.png"), renderDepth(pipeline.depth(p)).view()));
         !ok) {
       return ok;
     }
   }
-  return writeOrFail(sim::writePngRgb8(dir / (camera.id + ".depth.png"),
-                                       renderDepth(pipeline.merged()).view()));
+  return writeOrFail(
+      sim::writePngRgb8(dir / (camera.id + ".depth.png"), renderDepth(pipeline.merged()).view()));
 }
 
-struct CameraResult {
-  Json meta;
-  std::vector<sim::PlyPoint> points;
-};
-
-std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
-                                                  const CameraImage& input,
-                                                  const CliStreams& io) {
+// Runs one camera's image through the pipeline, writes its files, and appends its meta.json entry
+// to `cameras` and its world points to `merged`.
+std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
+                                          const CameraImage& input, const CliStreams& io,
+                                          Json& cameras, std::vector<sim::PlyPoint>& merged) {
   const algo::Camera& camera = rig.cameras[input.camera];
   const auto image = readCameraImage(input.file, camera);
   if (!image) {
@@ -108,7 +105,8 @@ std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, con
   }
   const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
   if (!bytes) {
-    return std::unexpected(Failure{kExitBadInput, std::string("pipeline: ") + bytes.error().message});
+    return std::unexpected(
+        Failure{kExitBadInput, std::string("pipeline: ") + bytes.error().message});
   }
   std::vector<std::byte> memory(*bytes);
   algo::Arena arena(memory);
@@ -139,7 +137,6 @@ std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, con
   }
   timings["total"] = totalMs;
 
-  CameraResult result;
   Json pairs = Json::array();
   for (int p = 0; p < pipeline->projectors(); ++p) {
     const std::string name =
@@ -158,9 +155,10 @@ std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, con
   if (auto w = writeOrFail(sim::writePngGray16(opts.out / depthName, pipeline->merged())); !w) {
     return std::unexpected(w.error());
   }
-  result.points = depthToWorldPoints(camera, pipeline->merged(), opts.depthUnitM, image->view());
+  const auto points =
+      depthToWorldPoints(camera, pipeline->merged(), opts.depthUnitM, image->view());
   const std::string plyName = camera.id + ".ply";
-  if (auto w = writeOrFail(sim::writePlyPoints(opts.out / plyName, result.points)); !w) {
+  if (auto w = writeOrFail(sim::writePlyPoints(opts.out / plyName, points)); !w) {
     return std::unexpected(w.error());
   }
   if (opts.debug) {
@@ -176,17 +174,18 @@ std::expected<CameraResult, Failure> decodeCamera(const DecodeOptions& opts, con
     io.out << "  " << pair["projector"].get<std::string>() << ": "
            << pair["valid_pixels"].get<int>() << " depth pixels\n";
   }
-  result.meta = {{"id", camera.id},
-                 {"image", input.file.string()},
-                 {"width", camera.width},
-                 {"height", camera.height},
-                 {"depth", depthName},
-                 {"ply", plyName},
-                 {"valid_pixels", valid},
-                 {"working_memory_bytes", *bytes},
-                 {"timings_ms", timings},
-                 {"pairs", pairs}};
-  return result;
+  merged.insert(merged.end(), points.begin(), points.end());
+  cameras.push_back({{"id", camera.id},
+                     {"image", input.file.string()},
+                     {"width", camera.width},
+                     {"height", camera.height},
+                     {"depth", depthName},
+                     {"ply", plyName},
+                     {"valid_pixels", valid},
+                     {"working_memory_bytes", *bytes},
+                     {"timings_ms", timings},
+                     {"pairs", pairs}});
+  return {};
 }
 
 int runDecode(const DecodeOptions& opts, const CliStreams& io) {
@@ -205,28 +204,23 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
   for (const auto& dir : {std::optional(opts.out), opts.debug}) {
     std::error_code ec;
     if (dir && (fs::create_directories(*dir, ec), ec)) {
-      return fail(kExitDeviceOrIo, "cannot create directory " + dir->string() + ": " + ec.message());
+      return fail(kExitDeviceOrIo,
+                  "cannot create directory " + dir->string() + ": " + ec.message());
     }
   }
   Json cameras = Json::array();
   std::vector<sim::PlyPoint> merged;
   for (const CameraImage& input : *images) {
-    auto result = decodeCamera(opts, *rig, input, io);
-    if (!result) {
-      return fail(result.error().code, result.error().message);
+    if (auto ok = decodeCamera(opts, *rig, input, io, cameras, merged); !ok) {
+      return fail(ok.error().code, ok.error().message);
     }
-    cameras.push_back(result->meta);
-    merged.insert(merged.end(), result->points.begin(), result->points.end());
   }
   if (auto ok = sim::writePlyPoints(opts.out / "merged.ply", merged); !ok) {
     return fail(kExitDeviceOrIo, ok.error());
   }
-  const Json meta = {{"format", "stripemux-decode/1"},
-                     {"depth_unit_m", opts.depthUnitM},
-                     {"rig", opts.rig.string()},
-                     {"cameras", cameras},
-                     {"merged_ply", "merged.ply"},
-                     {"merged_points", merged.size()}};
+  const Json meta = {{"format", "stripemux-decode/1"}, {"depth_unit_m", opts.depthUnitM},
+                     {"rig", opts.rig.string()},       {"cameras", cameras},
+                     {"merged_ply", "merged.ply"},     {"merged_points", merged.size()}};
   std::ofstream file(opts.out / "meta.json");
   file << meta.dump(2) << "\n";
   if (!file) {

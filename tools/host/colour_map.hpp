@@ -13,9 +13,10 @@ namespace smx::host {
 
 // A black image.
 [[nodiscard]] inline sim::RgbImage blankImage(int width, int height) {
-  return {width, height,
-          std::vector<algo::Rgb8>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
-                                  algo::Rgb8{0, 0, 0})};
+  return {
+      width, height,
+      std::vector<algo::Rgb8>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
+                              algo::Rgb8{0, 0, 0})};
 }
 
 // The colour of hue (turns: 0 red, ⅓ green, ⅔ blue; wraps) at full saturation and value 0…1.

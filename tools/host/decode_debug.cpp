@@ -1,13 +1,12 @@
 #include "decode_debug.hpp"
 
-#include "colour_map.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-namespace smx::host {
+#include "colour_map.hpp"
 
+namespace smx::host {
 
 sim::RgbImage renderDepth(algo::ConstDepthPlane depth, std::uint16_t nearUnits,
                           std::uint16_t farUnits) {
@@ -54,7 +53,8 @@ sim::RgbImage renderStripes(algo::ConstStripePlane stripe) {
       const double v = static_cast<double>(s) / algo::kStripeOne;
       const double index = std::floor(v);
       image.pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(stripe.width()) +
-                   static_cast<std::size_t>(x)] = hueColour(index * kGoldenRatio, 0.5 + 0.5 * (v - index));
+                   static_cast<std::size_t>(x)] =
+          hueColour(index * kGoldenRatio, 0.5 + 0.5 * (v - index));
     }
   }
   return image;

@@ -1,10 +1,10 @@
 #include "demux_debug.hpp"
 
-#include "colour_map.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+
+#include "colour_map.hpp"
 
 namespace smx::host {
 

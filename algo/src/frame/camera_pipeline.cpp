@@ -106,11 +106,19 @@ Result<CameraPipeline> CameraPipeline::create(const CameraPipelineSetup& setup, 
   return c;
 }
 
+// The stages check that create() set their objects (it always does; a pipeline exists only
+// after it), which also keeps every optional access visibly checked.
 Result<void> CameraPipeline::demultiplex(ConstRgbView image) {
+  if (!demux_) {
+    return fail(Errc::kInvalidArgument, "pipeline: not created");
+  }
   return demux_->run(image);
 }
 
 Result<void> CameraPipeline::decode() {
+  if (!demux_ || !decoder_) {
+    return fail(Errc::kInvalidArgument, "pipeline: not created");
+  }
   for (int p = 0; p < layout_.projectors; ++p) {
     const auto i = static_cast<std::size_t>(p);
     if (auto ok = decoder_->run(demux_->boundaries(p), demux_->directions(p), stripes_[i]); !ok) {
@@ -132,7 +140,11 @@ Result<void> CameraPipeline::decode() {
 Result<void> CameraPipeline::triangulate() {
   for (int p = 0; p < layout_.projectors; ++p) {
     const auto i = static_cast<std::size_t>(p);
-    if (auto ok = triangulators_[i]->run(stripes_[i], depths_[i]); !ok) {
+    const std::optional<Triangulator>& triangulator = triangulators_[i];
+    if (!triangulator) {
+      return fail(Errc::kInvalidArgument, "pipeline: not created");
+    }
+    if (auto ok = triangulator->run(stripes_[i], depths_[i]); !ok) {
       return ok;
     }
   }
@@ -144,9 +156,9 @@ Result<void> CameraPipeline::merge() {
   for (std::size_t i = 0; i < static_cast<std::size_t>(layout_.projectors); ++i) {
     inputs[i] = depths_[i];
   }
-  return mergeRanges(std::span<const ConstDepthPlane>(inputs.data(),
-                                                      static_cast<std::size_t>(layout_.projectors)),
-                     merged_);
+  return mergeRanges(
+      std::span<const ConstDepthPlane>(inputs.data(), static_cast<std::size_t>(layout_.projectors)),
+      merged_);
 }
 
 Result<void> CameraPipeline::run(ConstRgbView image) {

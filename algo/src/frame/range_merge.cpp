@@ -31,17 +31,17 @@ int compareVariance(const Set& a, const Set& b) {
 }
 
 // Median of v[0 … n), n ≥ 1, sorting it in place (insertion sort: n ≤ 72, usually ≤ 18).
-std::uint16_t median(std::array<std::uint16_t, kMaxValues>& v, int n) {
-  for (int i = 1; i < n; ++i) {
-    const std::uint16_t x = v[static_cast<std::size_t>(i)];
-    int j = i - 1;
-    while (j >= 0 && v[static_cast<std::size_t>(j)] > x) {
-      v[static_cast<std::size_t>(j + 1)] = v[static_cast<std::size_t>(j)];
+std::uint16_t median(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
+  for (std::size_t i = 1; i < n; ++i) {
+    const std::uint16_t x = v[i];
+    std::size_t j = i;
+    while (j > 0 && v[j - 1] > x) {
+      v[j] = v[j - 1];
       --j;
     }
-    v[static_cast<std::size_t>(j + 1)] = x;
+    v[j] = x;
   }
-  const auto mid = static_cast<std::size_t>(n / 2);
+  const std::size_t mid = n / 2;
   if (n % 2 == 1) {
     return v[mid];
   }
@@ -98,27 +98,25 @@ Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out
           continue;
         }
         int keep = 0;  // −1: the running choice, 1: the new set, 0: both
-        if (best.count == 0) {
+        if (best.count == 0 || set.count - best.count > 3) {
           keep = 1;
         } else if (best.count - set.count > 3) {
           keep = -1;
-        } else if (set.count - best.count > 3) {
-          keep = 1;
         } else {
           keep = compareVariance(best, set);
         }
         if (keep < 0) {
           continue;
         }
-        const int at = keep == 0 ? best.count : 0;
-        for (int i = 0; i < set.count; ++i) {
-          chosen[static_cast<std::size_t>(at + i)] = next[static_cast<std::size_t>(i)];
+        const auto at = static_cast<std::size_t>(keep == 0 ? best.count : 0);
+        for (std::size_t i = 0; i < static_cast<std::size_t>(set.count); ++i) {
+          chosen[at + i] = next[i];
         }
         best = keep == 0 ? Set{best.count + set.count, best.sum + set.sum,
                                best.sumSquares + set.sumSquares}
                          : set;
       }
-      o[x] = median(chosen, best.count);
+      o[x] = median(chosen, static_cast<std::size_t>(best.count));
     }
   }
   return {};

@@ -42,6 +42,12 @@ std::int32_t along(PointQ8 from, PointQ8 to, Unit u) {
   return static_cast<std::int32_t>(dot >> 14);
 }
 
+// Index of (x, y) in the decoder's unpadded per-pixel planes.
+constexpr std::size_t flat(int x, int y, int width) {
+  return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+         static_cast<std::size_t>(x);
+}
+
 constexpr std::int32_t pack(int x, int y) {
   return (y << 16) | x;
 }
@@ -56,8 +62,8 @@ Result<void> validate(int width, int height, const DecodeParams& p) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192) {
     return fail(Errc::kInvalidArgument, "decode: image size must be 1 to 8192 pixels per side");
   }
-  if (p.maxGapPx < 1 || p.maxGapPx > 64 || p.minSeparationQ8 < 0 ||
-      p.minSeparationQ8 > 64 * 256 || p.minCurveVotes < 1 || p.minCurveVotes > 1 << 20) {
+  if (p.maxGapPx < 1 || p.maxGapPx > 64 || p.minSeparationQ8 < 0 || p.minSeparationQ8 > 64 * 256 ||
+      p.minCurveVotes < 1 || p.minCurveVotes > 1 << 20) {
     return fail(Errc::kInvalidArgument,
                 "decode: maxGapPx 1 to 64, minSeparationQ8 0 to 16384, minCurveVotes >= 1");
   }
@@ -223,7 +229,7 @@ void StripeDecoder::link(ConstDirectionPlane d) {
   for (int y = 0; y < height_; ++y) {
     const std::uint16_t* dirs = d.rowPtr(y);
     for (int x = 0; x < width_; ++x) {
-      const auto i = static_cast<std::size_t>(y * width_ + x);
+      const std::size_t i = flat(x, y, width_);
       next_[i] = kNone;
       prev_[i] = kNone;
       if (code_[i] == 0) {
@@ -241,9 +247,8 @@ void StripeDecoder::link(ConstDirectionPlane d) {
           const std::int32_t dist = sign * along(p, qp, u);
           return dist >= params_.minSeparationQ8 ? dist : -1;
         };
-        (sign > 0 ? next_ : prev_)[i] =
-            walk(code_, width_, height_, p, sign * (u.x >> 7), sign * (u.y >> 7), 1, steps,
-                 distance);
+        (sign > 0 ? next_ : prev_)[i] = walk(code_, width_, height_, p, sign * (u.x >> 7),
+                                             sign * (u.y >> 7), 1, steps, distance);
       }
     }
   }
@@ -253,7 +258,7 @@ void StripeDecoder::link(ConstDirectionPlane d) {
 // window of 6 consecutive transitions in it.
 void StripeDecoder::vote() {
   const auto indexOf = [this](std::int32_t packed) {
-    return static_cast<std::size_t>(packedY(packed) * width_ + packedX(packed));
+    return flat(packedX(packed), packedY(packed), width_);
   };
   const auto kindAt = [this](std::size_t i) {
     return static_cast<stripe::Transition>(code_[i] - 1);
@@ -363,20 +368,19 @@ void StripeDecoder::joinCurves() {
     for (int y = 0; y < height_; ++y) {
       for (int x = 0; x < width_; ++x) {
         const std::int32_t i = y * width_ + x;
-        const std::uint8_t t = code_[static_cast<std::size_t>(i)];
+        const std::uint8_t t = code_[flat(x, y, width_)];
         if (t == 0) {
           continue;
         }
-        if (x + 1 < width_ && code_[static_cast<std::size_t>(i + 1)] == t) {
+        if (x + 1 < width_ && code_[flat(x + 1, y, width_)] == t) {
           unite(i, i + 1);
         }
         if (y + 1 == height_) {
           continue;
         }
         for (int dx = -1; dx <= 1; ++dx) {
-          const std::int32_t below = i + width_ + dx;
-          if (x + dx >= 0 && x + dx < width_ && code_[static_cast<std::size_t>(below)] == t) {
-            unite(i, below);
+          if (x + dx >= 0 && x + dx < width_ && code_[flat(x + dx, y + 1, width_)] == t) {
+            unite(i, i + width_ + dx);
           }
         }
       }
@@ -433,7 +437,7 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
   const demux::UnitTable& units = units_[0];
   const int steps = 2 * params_.maxGapPx;
   const auto positionOf = [this](int x, int y) {
-    const Shift s = shift_[static_cast<std::size_t>(y * width_ + x)];
+    const Shift s = shift_[flat(x, y, width_)];
     return PointQ8{x * 256 + s.x, y * 256 + s.y};
   };
   for (int y = 0; y < height_; ++y) {
@@ -453,11 +457,10 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
       }
       const int qx = packedX(q);
       const int qy = packedY(q);
-      const std::size_t qi = static_cast<std::size_t>(qy * width_ + qx);
+      const std::size_t qi = flat(qx, qy, width_);
       const std::int32_t level = level_[qi];
       const std::int32_t n = next_[qi];
-      if (level == 0 || n == kNone ||
-          level_[static_cast<std::size_t>(packedY(n) * width_ + packedX(n))] != level + 1) {
+      if (level == 0 || n == kNone || level_[flat(packedX(n), packedY(n), width_)] != level + 1) {
         continue;
       }
       const std::int32_t first = along(positionOf(qx, qy), here, u);

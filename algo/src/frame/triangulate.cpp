@@ -22,8 +22,8 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   if (auto bytes = workspaceBytes(tables.width, tables.height); !bytes) {
     return std::unexpected(bytes.error());
   }
-  const auto pixels = static_cast<std::size_t>(tables.width) *
-                      static_cast<std::size_t>(tables.height);
+  const auto pixels =
+      static_cast<std::size_t>(tables.width) * static_cast<std::size_t>(tables.height);
   if (tables.denominatorBase.size() != pixels || tables.denominatorSlope.size() != pixels ||
       tables.sense.size() != pixels) {
     return fail(Errc::kSizeMismatch, "triangulation: tables must hold width x height entries");
@@ -52,7 +52,8 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
 Result<void> Triangulator::run(ConstStripePlane stripe, DepthPlane depth) const {
   if (stripe.width() != width_ || stripe.height() != height_ || depth.width() != width_ ||
       depth.height() != height_) {
-    return fail(Errc::kSizeMismatch, "triangulation: stripe and depth planes must match the tables");
+    return fail(Errc::kSizeMismatch,
+                "triangulation: stripe and depth planes must match the tables");
   }
   for (int y = 0; y < height_; ++y) {
     const StripeQ16* s = stripe.rowPtr(y);

@@ -48,8 +48,7 @@ std::expected<void, std::string> writePlyPoints(const std::filesystem::path& pat
   return {};
 }
 
-std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(
-    const std::filesystem::path& path) {
+std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     return failure(path, "cannot open");
@@ -89,7 +88,7 @@ std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(
       std::string type;
       std::string name;
       words >> type >> name;
-      properties.push_back(type + " " + name);
+      properties.push_back(type.append(" ").append(name));
     } else {
       return failure(path, "unexpected header line '" + line + "'");
     }
@@ -98,7 +97,7 @@ std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(
     return failure(path, "truncated or incomplete PLY header");
   }
   const std::vector<std::string> xyz = {"float x", "float y", "float z"};
-  const std::vector<std::string> xyzrgb = {"float x",     "float y",       "float z",
+  const std::vector<std::string> xyzrgb = {"float x",   "float y",     "float z",
                                            "uchar red", "uchar green", "uchar blue"};
   const bool colour = properties == xyzrgb;
   if (properties != xyz && !colour) {
@@ -121,8 +120,8 @@ std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(
       char record[kRecordBytes];
       const std::size_t bytes = colour ? kRecordBytes : 3 * sizeof(float);
       if (!in.read(record, static_cast<std::streamsize>(bytes))) {
-        return failure(path, "truncated: " + std::to_string(i) + " of " + std::to_string(count) +
-                                 " vertices");
+        return failure(
+            path, "truncated: " + std::to_string(i) + " of " + std::to_string(count) + " vertices");
       }
       std::memcpy(&p.x, record, sizeof(float));
       std::memcpy(&p.y, record + 4, sizeof(float));

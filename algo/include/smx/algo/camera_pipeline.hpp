@@ -35,7 +35,7 @@ struct CameraPipelineSetup {
   DemuxLayout layout;
   DecodeParams decode;
   double depthUnitM = kDefaultDepthUnitM;
-  std::vector<std::uint16_t> predictedAngles;       // Demultiplexer::create's
+  std::vector<std::uint16_t> predictedAngles;      // Demultiplexer::create's
   std::vector<TriangulationTables> triangulation;  // per projector
 };
 [[nodiscard]] std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
@@ -55,7 +55,10 @@ class CameraPipeline {
   [[nodiscard]] Result<void> run(ConstRgbView image);
 
   [[nodiscard]] int projectors() const { return layout_.projectors; }
+  // create() sets every stage object: a CameraPipeline exists only after it.
+  // NOLINTNEXTLINE(bugprone-unchecked-optional-access)
   [[nodiscard]] const Demultiplexer& demux() const { return *demux_; }
+  // NOLINTNEXTLINE(bugprone-unchecked-optional-access)
   [[nodiscard]] Demultiplexer& demux() { return *demux_; }
   [[nodiscard]] ConstStripePlane stripe(int projector) const;
   [[nodiscard]] ImageView<const std::int16_t> levels(int projector) const;

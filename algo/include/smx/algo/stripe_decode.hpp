@@ -31,10 +31,10 @@
 namespace smx::algo {
 
 struct DecodeParams {
-  int maxGapPx = 12;         // link search distance along the axis (≈ 2.5 stripe periods)
+  int maxGapPx = 12;          // link search distance along the axis (≈ 2.5 stripe periods)
   int minSeparationQ8 = 192;  // a linked boundary lies at least this far along the axis (Q8 px)
-  int minCurveVotes = 8;     // a curve's level needs this many agreeing windows (over its pixels)
-  bool curves = true;        // step 3 (off: each pixel is a curve of its own)
+  int minCurveVotes = 8;      // a curve's level needs this many agreeing windows (over its pixels)
+  bool curves = true;         // step 3 (off: each pixel is a curve of its own)
 };
 
 // Counts of the last run, for evaluation and the debug output.

@@ -33,8 +33,8 @@ namespace smx::algo {
 struct TriangulationTables {
   int width = 0;
   int height = 0;
-  std::int64_t numeratorBase = 0;   // A'
-  std::int64_t numeratorSlope = 0;  // B' (per Q16 unit of s)
+  std::int64_t numeratorBase = 0;              // A'
+  std::int64_t numeratorSlope = 0;             // B' (per Q16 unit of s)
   std::vector<std::int32_t> denominatorBase;   // C' per pixel, row-major
   std::vector<std::int32_t> denominatorSlope;  // D' per pixel
   std::vector<std::int8_t> sense;  // sign(B·C − A·D) per pixel; 0 where the pixel has no ray
@@ -58,8 +58,7 @@ class Triangulator {
 
   [[nodiscard]] static Result<std::size_t> workspaceBytes(int width, int height);
   // Copies the tables into the arena.
-  [[nodiscard]] static Result<Triangulator> create(const TriangulationTables& tables,
-                                                   Arena& arena);
+  [[nodiscard]] static Result<Triangulator> create(const TriangulationTables& tables, Arena& arena);
 
   // z in depth units for pixel (x, y) (inside the image) and stripe coordinate s; kNoDepth
   // where s is kNoStripe, the pixel has no ray, the point is behind the camera or the projector,
