@@ -1,6 +1,9 @@
 #include "camera_images.hpp"
 
 #include <optional>
+#include <utility>
+
+#include "smx/protocol/rig_json.hpp"
 
 namespace smx::host {
 
@@ -31,6 +34,19 @@ std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
     out.push_back({*index, spec.substr(eq + 1)});
   }
   return out;
+}
+
+std::expected<RigAndImages, std::string> loadRigAndImages(const std::filesystem::path& rigFile,
+                                                          const std::vector<std::string>& specs) {
+  auto rig = protocol::loadRig(rigFile);
+  if (!rig) {
+    return std::unexpected(rig.error().message());
+  }
+  auto images = parseCameraImages(specs, *rig);
+  if (!images) {
+    return std::unexpected(images.error());
+  }
+  return RigAndImages{std::move(*rig), std::move(*images)};
 }
 
 std::expected<sim::RgbImage, std::string> readCameraImage(const std::filesystem::path& file,

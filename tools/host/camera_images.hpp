@@ -22,6 +22,14 @@ struct CameraImage {
 [[nodiscard]] std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
     const std::vector<std::string>& specs, const algo::Rig& rig);
 
+// The rig file and the `--image` specs of a command, checked together.
+struct RigAndImages {
+  algo::Rig rig;
+  std::vector<CameraImage> images;
+};
+[[nodiscard]] std::expected<RigAndImages, std::string> loadRigAndImages(
+    const std::filesystem::path& rigFile, const std::vector<std::string>& specs);
+
 // Reads the PNG and checks it has the camera's size; errors name the file.
 [[nodiscard]] std::expected<sim::RgbImage, std::string> readCameraImage(
     const std::filesystem::path& file, const algo::Camera& camera);

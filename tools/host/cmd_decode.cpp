@@ -19,7 +19,6 @@
 #include "demux_debug.hpp"
 #include "point_cloud.hpp"
 #include "smx/algo/camera_pipeline.hpp"
-#include "smx/protocol/rig_json.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
 
@@ -193,14 +192,12 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
     io.err << "stripemux decode: " << message << "\n";
     return code;
   };
-  const auto rig = protocol::loadRig(opts.rig);
-  if (!rig) {
-    return fail(kExitBadInput, rig.error().message());
+  const auto loaded = loadRigAndImages(opts.rig, opts.images);
+  if (!loaded) {
+    return fail(kExitBadInput, loaded.error());
   }
-  const auto images = parseCameraImages(opts.images, *rig);
-  if (!images) {
-    return fail(kExitBadInput, images.error());
-  }
+  const algo::Rig* rig = &loaded->rig;
+  const std::vector<CameraImage>* images = &loaded->images;
   for (const auto& dir : {std::optional(opts.out), opts.debug}) {
     std::error_code ec;
     if (dir && (fs::create_directories(*dir, ec), ec)) {

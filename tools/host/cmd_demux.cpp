@@ -16,7 +16,6 @@
 #include "demux_debug.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/encoding_prediction.hpp"
-#include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
 
 namespace smx::host {
@@ -36,14 +35,12 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
     io.err << "stripemux demux: " << message << "\n";
     return code;
   };
-  const auto rig = protocol::loadRig(opts.rig);
-  if (!rig) {
-    return fail(kExitBadInput, rig.error().message());
+  const auto loaded = loadRigAndImages(opts.rig, opts.images);
+  if (!loaded) {
+    return fail(kExitBadInput, loaded.error());
   }
-  const auto images = parseCameraImages(opts.images, *rig);
-  if (!images) {
-    return fail(kExitBadInput, images.error());
-  }
+  const algo::Rig* rig = &loaded->rig;
+  const std::vector<CameraImage>* images = &loaded->images;
   if (opts.debug) {
     std::error_code ec;
     fs::create_directories(*opts.debug, ec);

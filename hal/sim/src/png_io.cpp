@@ -41,6 +41,20 @@ std::expected<void, std::string> writePacked(const std::filesystem::path& path,
   return {};
 }
 
+// Reads the pixels of a PNG whose header png_image_begin_read has read, in png.format, into an
+// image with width, height and a pixel vector.
+template <class Image>
+std::expected<Image, std::string> finishRead(const std::filesystem::path& path, png_image& png) {
+  Image out;
+  out.width = static_cast<int>(png.width);
+  out.height = static_cast<int>(png.height);
+  out.pixels.resize(static_cast<std::size_t>(png.width) * png.height);
+  if (png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) == 0) {
+    return std::unexpected(describe(path, png));
+  }
+  return out;
+}
+
 }  // namespace
 
 std::expected<void, std::string> writePngRgb8(const std::filesystem::path& path,
@@ -73,14 +87,7 @@ std::expected<Gray16Image, std::string> readPngGray16(const std::filesystem::pat
                            ((png.format & PNG_FORMAT_FLAG_ALPHA) != 0 ? ", with alpha" : "") +
                            "); depth images are 16-bit grey");
   }
-  Gray16Image out;
-  out.width = static_cast<int>(png.width);
-  out.height = static_cast<int>(png.height);
-  out.pixels.resize(static_cast<std::size_t>(png.width) * png.height);
-  if (png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) == 0) {
-    return std::unexpected(describe(path, png));
-  }
-  return out;
+  return finishRead<Gray16Image>(path, png);
 }
 
 std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& path) {
@@ -91,14 +98,7 @@ std::expected<RgbImage, std::string> readPngRgb8(const std::filesystem::path& pa
     return std::unexpected(describe(path, png));
   }
   png.format = PNG_FORMAT_RGB;
-  RgbImage out;
-  out.width = static_cast<int>(png.width);
-  out.height = static_cast<int>(png.height);
-  out.pixels.resize(static_cast<std::size_t>(png.width) * png.height);
-  if (png_image_finish_read(&png, nullptr, out.pixels.data(), 0, nullptr) == 0) {
-    return std::unexpected(describe(path, png));
-  }
-  return out;
+  return finishRead<RgbImage>(path, png);
 }
 
 }  // namespace smx::sim
