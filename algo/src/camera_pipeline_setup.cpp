@@ -15,6 +15,7 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
   CameraPipelineSetup setup;
   setup.layout = {cam.width, cam.height, static_cast<int>(rig.projectors.size()), options.demux};
   setup.decode = options.decode;
+  setup.edgeJumpPermille = options.edgeJumpPermille;
   setup.depthUnitM = options.depthUnitM;
   auto angles = predictEncodingAngles(rig, camera, setup.layout, options.nominalDepthM);
   if (!angles) {

@@ -1,5 +1,6 @@
 // The paper's median-variant merge (range_merge.hpp) on hand-worked windows, each built so that a
-// plausible wrong rule gives another answer, and against a plain reference over random planes.
+// plausible wrong rule gives another answer, and against a plain reference over random planes;
+// the depth-edge filter (depth_edges.hpp) that runs before it.
 #include "smx/algo/range_merge.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "smx/algo/depth_edges.hpp"
 
 namespace smx::algo {
 namespace {
@@ -220,6 +222,36 @@ TEST(RangeMerge, MatchesAPlainReferenceOnRandomSparsePlanesWithoutTouchingTheHea
       }
     }
   }
+}
+
+// The depth-edge filter: a 5×3 image with a step from 1000 to 1100 units (10 %) between columns
+// 1 and 2 and a gentle ramp (1 % per pixel) elsewhere.
+TEST(DepthEdges, DropsBothSidesOfAJumpAndKeepsSmoothSurfaces) {
+  const int w = 5;
+  const int h = 3;
+  // row-major: columns 0–1 near (1000, 1010), columns 2–4 far (1100, 1111, 1122), a hole at (4, 0)
+  const std::vector<std::uint16_t> in = {1000, 1010, 1100, 1111, 0,     //
+                                         1000, 1010, 1100, 1111, 1122,  //
+                                         1000, 1010, 1100, 1111, 1122};
+  std::vector<std::uint16_t> out(in.size(), 7);
+  ASSERT_TRUE(
+      removeDepthEdges(*ConstDepthPlane::packed(in, w, h), *DepthPlane::packed(out, w, h), 20));
+  // 2 %: column 1 (1010 beside 1100: 8.9 %) and column 2 (1100 beside 1010: 8.2 %) go; columns 0,
+  // 3, 4 stay (their neighbours differ by ≤ 1 %); the hole stays a hole and is not an edge.
+  const std::vector<std::uint16_t> expected = {1000, 0, 0, 1111, 0,     //
+                                               1000, 0, 0, 1111, 1122,  //
+                                               1000, 0, 0, 1111, 1122};
+  EXPECT_EQ(out, expected);
+  // At 10 % the step (8.2–8.9 %) stays; 0 copies unchanged.
+  ASSERT_TRUE(
+      removeDepthEdges(*ConstDepthPlane::packed(in, w, h), *DepthPlane::packed(out, w, h), 100));
+  EXPECT_EQ(out, in);
+  ASSERT_TRUE(
+      removeDepthEdges(*ConstDepthPlane::packed(in, w, h), *DepthPlane::packed(out, w, h), 0));
+  EXPECT_EQ(out, in);
+  std::vector<std::uint16_t> small(4);
+  EXPECT_FALSE(
+      removeDepthEdges(*ConstDepthPlane::packed(in, w, h), *DepthPlane::packed(small, 2, 2), 20));
 }
 
 }  // namespace

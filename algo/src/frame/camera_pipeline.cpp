@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "smx/algo/depth_edges.hpp"
 #include "smx/algo/range_merge.hpp"
 
 namespace smx::algo {
@@ -13,6 +14,9 @@ namespace {
 Result<void> validate(const CameraPipelineSetup& s) {
   if (s.layout.projectors < 1 || s.layout.projectors > kMaxProjectors) {
     return fail(Errc::kInvalidArgument, "pipeline: 1 to 3 projectors");
+  }
+  if (s.edgeJumpPermille < 0 || s.edgeJumpPermille > 1000) {
+    return fail(Errc::kInvalidArgument, "pipeline: edgeJumpPermille 0 to 1000");
   }
   if (s.triangulation.size() != static_cast<std::size_t>(s.layout.projectors)) {
     return fail(Errc::kSizeMismatch, "pipeline: one triangulation table per projector");
@@ -81,6 +85,7 @@ Result<CameraPipeline> CameraPipeline::create(const CameraPipelineSetup& setup, 
   };
   CameraPipeline c;
   c.layout_ = setup.layout;
+  c.edgeJumpPermille_ = setup.edgeJumpPermille;
   auto demux = Demultiplexer::create(setup.layout, setup.predictedAngles, arena);
   if (!demux) {
     return undo(demux.error());
@@ -144,7 +149,11 @@ Result<void> CameraPipeline::triangulate() {
     if (!triangulator) {
       return fail(Errc::kInvalidArgument, "pipeline: not created");
     }
-    if (auto ok = triangulator->run(stripes_[i], depths_[i]); !ok) {
+    // The merged plane is free until merge(): the unfiltered range image goes there first.
+    if (auto ok = triangulator->run(stripes_[i], merged_); !ok) {
+      return ok;
+    }
+    if (auto ok = removeDepthEdges(merged_, depths_[i], edgeJumpPermille_); !ok) {
       return ok;
     }
   }

@@ -18,9 +18,9 @@
 #include "smx/algo/triangulation.hpp"
 
 // One camera's frame through the whole pipeline (docs/decode.md): orientation demultiplexing →
-// per projector multi-layer decoding → triangulation → merging of the projectors' range images
-// (the paper's median-variant filter). Per frame integer-only and allocation-free; all memory is
-// carved from one arena at create().
+// per projector multi-layer decoding → triangulation and the depth-edge filter → merging of the
+// projectors' range images (the paper's median-variant filter). Per frame integer-only and
+// allocation-free; all memory is carved from one arena at create().
 namespace smx::algo {
 
 struct PipelineOptions {
@@ -28,12 +28,14 @@ struct PipelineOptions {
   double depthUnitM = kDefaultDepthUnitM;
   DemuxParams demux;
   DecodeParams decode;
+  int edgeJumpPermille = 20;  // depth-edge filter of each pair's range image (0: off)
 };
 
 // Init time (double, allocates): the tables the pipeline needs, computed from the rig.
 struct CameraPipelineSetup {
   DemuxLayout layout;
   DecodeParams decode;
+  int edgeJumpPermille = 20;
   double depthUnitM = kDefaultDepthUnitM;
   std::vector<std::uint16_t> predictedAngles;      // Demultiplexer::create's
   std::vector<TriangulationTables> triangulation;  // per projector
@@ -72,6 +74,7 @@ class CameraPipeline {
   [[nodiscard]] Result<void> carve(Carver& carver);
 
   DemuxLayout layout_;
+  int edgeJumpPermille_ = 0;
   std::optional<Demultiplexer> demux_;
   std::optional<StripeDecoder> decoder_;
   std::array<std::optional<Triangulator>, kMaxProjectors> triangulators_;
