@@ -426,6 +426,38 @@ void StripeDecoder::joinCurves() {
     }
     if (majority && (own_[i] == candidate_[r] || votes_[i] < 2)) {
       level_[i] = candidate_[r];
+    }
+  }
+  // The next layer: a curve's links should lead to decoded curves one level on either side.
+  // Per root, the links that do (weight_) and the links to decoded pixels that do not (total_);
+  // a curve whose links mostly disagree is dropped.
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    weight_[i] = 0;
+    total_[i] = 0;
+  }
+  const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
+    return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
+  };
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    const std::int32_t level = level_[i];
+    if (level == 0) {
+      continue;
+    }
+    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    const std::int32_t ahead = linkedLevel(next_[i]);
+    const std::int32_t behind = linkedLevel(prev_[i]);
+    weight_[r] += (ahead == level + 1 ? 1 : 0) + (behind == level - 1 ? 1 : 0);
+    total_[r] +=
+        (ahead != 0 && ahead != level + 1 ? 1 : 0) + (behind != 0 && behind != level - 1 ? 1 : 0);
+  }
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    if (level_[i] == 0) {
+      continue;
+    }
+    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    if (total_[r] > weight_[r]) {
+      level_[i] = 0;
+    } else {
       ++stats_.decodedPixels;
     }
   }

@@ -23,7 +23,9 @@
 //   3. curves: boundary pixels of one class that touch (8-neighbourhood) form a boundary curve;
 //      the curve's level is the weighted majority (Boyer–Moore, > half the votes, at least
 //      minCurveVotes) of its pixels' levels, and it is given to every pixel of the curve, voted
-//      or not; a pixel whose own votes (≥ 2) contradict its curve is dropped;
+//      or not; a pixel whose own votes (≥ 2) contradict its curve is dropped; then a curve whose
+//      links lead more often to decoded boundaries of other levels than to its neighbours' (level
+//      ± 1) is dropped;
 //   4. dense coordinate: each pixel walks back along −axis to the nearest boundary; when that
 //      boundary (level k) is decoded and its forward link holds level k + 1 beyond the pixel,
 //      s = k + (distance from the first) / (distance between the two), both measured along the
