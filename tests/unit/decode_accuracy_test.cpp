@@ -169,9 +169,11 @@ constexpr double kStatueBehindM = 1.15;
 
 constexpr Bounds kTargets{0.95, 0.90, 0.80, 0.001, 0.1};
 
-// The board: completeness and gross errors beat the targets; the disparity RMS (0.12–0.14 px)
-// does not yet: it is the boundaries' sub-pixel position noise (docs/demux.md, 0.14 px RMS),
-// which the stripe interpolation carries into depth (ratchet 0.16 px).
+// The board: completeness and gross errors beat the targets. The disparity RMS meets the target
+// with oblique patterns (three at 60°: 0.092 px; 70°: 0.100 px, asserted at 0.105) but not at 90°
+// (0.133 px, ratchet 0.16): there the boundaries run along pixel rows and columns, every pixel of
+// a curve has the same sub-pixel bias (docs/demux.md), and averaging along the curve cannot
+// remove it.
 constexpr Bounds kBoard{0.98, 0.98, 0.98, kTargets.grossRate / 2, 0.16};
 
 TEST(DecodeAccuracy, PlaneTwoPatterns90Deg) {
@@ -195,12 +197,16 @@ TEST(DecodeAccuracy, PlaneTwoPatterns70Deg) {
   auto rig = test::loadExampleRig("rig_2proj_1cam.json");
   rig.projectors[1].pattern.angleDeg = 70.0;
   const auto f = test::renderSimFrame(rig, test::loadNamedScene("plane"));
-  expectWithin(measure(f, "plane 2 x 70deg"), kBoard, "plane 70deg");
+  Bounds bounds = kBoard;
+  bounds.rmsDisparityPx = 0.105;
+  expectWithin(measure(f, "plane 2 x 70deg"), bounds, "plane 70deg");
 }
 
 TEST(DecodeAccuracy, PlaneThreePatterns60Deg) {
   const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
-  expectWithin(measure(f, "plane 3 x 60deg"), kBoard, "plane 3 patterns");
+  Bounds bounds = kBoard;
+  bounds.rmsDisparityPx = kTargets.rmsDisparityPx;
+  expectWithin(measure(f, "plane 3 x 60deg"), bounds, "plane 3 patterns");
 }
 
 // Curved and occluding scenes: completeness meets the target on smooth parts; gross errors

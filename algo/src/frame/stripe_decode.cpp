@@ -145,6 +145,7 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   link(directions);
   vote();
   joinCurves();
+  smoothPositions(directions);
   fill(directions, stripe);
   return {};
 }
@@ -459,6 +460,55 @@ void StripeDecoder::joinCurves() {
       level_[i] = 0;
     } else {
       ++stats_.decodedPixels;
+    }
+  }
+}
+
+// Step 3b. A decoded boundary's position along its axis becomes the mean over the pixels of the
+// same level within positionRadiusPx (the boundary is locally a line across the axis, so they
+// measure the same thing with independent noise). Means in Q8 (int32 sums of ≤ 81 terms), kept
+// in weight_ (free after step 3) until all are computed, then written back as shifts.
+void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
+  const int r = params_.positionRadiusPx;
+  if (r == 0) {
+    return;
+  }
+  const demux::UnitTable& units = units_[0];
+  for (int y = 0; y < height_; ++y) {
+    const std::uint16_t* dirs = d.rowPtr(y);
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = flat(x, y, width_);
+      const std::int16_t level = level_[i];
+      if (level == 0) {
+        continue;
+      }
+      const Unit u = unitOf(units, dirs[x]);
+      const PointQ8 centre{x * 256, y * 256};
+      std::int32_t sum = 0;
+      std::int32_t count = 0;
+      for (int qy = y > r ? y - r : 0; qy <= y + r && qy < height_; ++qy) {
+        for (int qx = x > r ? x - r : 0; qx <= x + r && qx < width_; ++qx) {
+          const std::size_t q = flat(qx, qy, width_);
+          if (level_[q] == level) {
+            sum += along(centre, {qx * 256 + shift_[q].x, qy * 256 + shift_[q].y}, u);
+            ++count;
+          }
+        }
+      }
+      // count ≥ 1 (the pixel itself counts); round half away from zero.
+      weight_[i] = count > 0 ? (sum >= 0 ? sum + count / 2 : sum - count / 2) / count : 0;
+    }
+  }
+  for (int y = 0; y < height_; ++y) {
+    const std::uint16_t* dirs = d.rowPtr(y);
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = flat(x, y, width_);
+      if (level_[i] == 0) {
+        continue;
+      }
+      const Unit u = unitOf(units, dirs[x]);
+      shift_[i] = {static_cast<std::int16_t>((weight_[i] * u.x + 8192) >> 14),
+                   static_cast<std::int16_t>((weight_[i] * u.y + 8192) >> 14)};
     }
   }
 }

@@ -25,7 +25,8 @@
 //      minCurveVotes) of its pixels' levels, and it is given to every pixel of the curve, voted
 //      or not; a pixel whose own votes (≥ 2) contradict its curve is dropped; then a curve whose
 //      links lead more often to decoded boundaries of other levels than to its neighbours' (level
-//      ± 1) is dropped;
+//      ± 1) is dropped; each decoded boundary's position becomes the mean over its level's pixels
+//      within positionRadiusPx (noise along a curve is independent, the curve locally straight);
 //   4. dense coordinate: each pixel walks back along −axis to the nearest boundary; when that
 //      boundary (level k) is decoded and its forward link holds level k + 1 beyond the pixel,
 //      s = k + (distance from the first) / (distance between the two), both measured along the
@@ -36,6 +37,7 @@ struct DecodeParams {
   int maxGapPx = 12;          // link search distance along the axis (≈ 2.5 stripe periods)
   int minSeparationQ8 = 192;  // a linked boundary lies at least this far along the axis (Q8 px)
   int minCurveVotes = 8;      // a curve's level needs this many agreeing windows (over its pixels)
+  int positionRadiusPx = 2;   // boundary positions averaged along their curve (0: off)
   bool curves = true;         // step 3 (off: each pixel is a curve of its own)
 };
 
@@ -81,6 +83,7 @@ class StripeDecoder {
   void link(ConstDirectionPlane d);
   void vote();
   void joinCurves();
+  void smoothPositions(ConstDirectionPlane d);
   void fill(ConstDirectionPlane d, StripePlane stripe);
 
   // A boundary's position relative to its pixel centre, Q8 pixels.
