@@ -1,0 +1,117 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "smx/algo/range_image.hpp"
+#include "smx/protocol/wire.hpp"
+
+// The messages of protocol version 1 (docs/protocol.md). Encoders write a whole message (header
+// and payload) into a caller's buffer; decoders check a payload and return views into it, so
+// neither side allocates per message. Strings are UTF-8 with a length prefix.
+namespace smx::protocol {
+
+enum class Compression : std::uint8_t { kNone = 0, kRvl = 1 };
+[[nodiscard]] const char* toString(Compression compression);
+
+struct Hello {
+  std::string_view client;  // e.g. "stripemux 0.1.0"
+};
+
+struct Capabilities {
+  std::string_view board;
+  std::string_view firmwareVersion;
+  std::string_view halBackend;  // "sim" or "linux"
+  std::uint32_t depthUnitNm = 100'000;
+  std::uint8_t cameras = 0;
+  std::uint8_t projectors = 0;
+  std::uint16_t width = 0;  // of every camera (the rig's cameras share one size on a board)
+  std::uint16_t height = 0;
+  std::uint16_t fps = 0;              // the capture rate the board aims at
+  std::uint8_t compressionsMask = 0;  // bit (1 << Compression) for each one it can send
+  std::string_view rigJson;           // the board's rig.json, stripemux-rig/1
+};
+
+struct StartStream {
+  Compression compression = Compression::kRvl;
+};
+
+struct RangeFrameHeader {
+  std::uint8_t camera = 0;  // index into the rig's cameras
+  Compression compression = Compression::kRvl;
+  std::uint16_t width = 0;
+  std::uint16_t height = 0;
+  std::uint64_t frame = 0;              // the device's frame number, from 0 at start-up
+  std::int64_t captureTimestampNs = 0;  // device clock, start of exposure
+  std::int64_t sentTimestampNs = 0;     // device clock, when the frame was queued for sending
+  std::uint32_t depthUnitNm = 100'000;
+  std::uint32_t decodeTimeUs = 0;  // the pipeline's time for this camera's frame
+};
+
+// A range frame as received: its header and the (possibly compressed) depth bytes.
+struct RangeFrameView {
+  RangeFrameHeader header;
+  std::span<const std::byte> depth;
+};
+
+struct Statistics {
+  std::uint64_t uptimeMs = 0;
+  std::uint64_t framesCaptured = 0;  // camera frames acquired
+  std::uint64_t framesDecoded = 0;   // range frames computed (one per camera per capture)
+  std::uint64_t framesSent = 0;      // range frames fully handed to the link
+  std::uint64_t framesDropped = 0;   // dropped from the send queue because the host was slow
+  std::uint64_t captureErrors = 0;   // timeouts, lost cameras
+  std::uint64_t protocolErrors = 0;  // malformed messages received
+  std::uint32_t decodeTimeUsLast = 0;
+  std::uint32_t decodeTimeUsMean = 0;
+};
+
+enum class ErrorCode : std::uint16_t {
+  kUnsupportedVersion = 1,
+  kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
+  kBusy = 3,        // another host is connected
+  kInternal = 4,
+};
+
+struct ErrorMessage {
+  ErrorCode code = ErrorCode::kBadRequest;
+  std::string_view text;
+};
+
+// Encoders: the whole message in `out`, or kBufferTooSmall.
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const Hello& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const Capabilities& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const StartStream& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const Statistics& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const ErrorMessage& m,
+                                                                std::span<std::byte> out);
+// A message without payload: stop-stream, get-statistics.
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type,
+                                                                     std::span<std::byte> out);
+// A range frame of `depth` (width × height from the plane). RVL falls back to kNone when the
+// compressed image would be larger than the raw one; the header says which was sent.
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRangeFrame(
+    RangeFrameHeader header, algo::ConstDepthPlane depth, std::span<std::byte> out);
+// Bytes a range frame of that size needs at most.
+[[nodiscard]] constexpr std::size_t rangeFrameBound(int width, int height) {
+  return kHeaderBytes + 40 + 2 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+}
+
+[[nodiscard]] ProtocolResult<Hello> decodeHello(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<Capabilities> decodeCapabilities(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<StartStream> decodeStartStream(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<Statistics> decodeStatistics(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<ErrorMessage> decodeError(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> payload);
+// Expands a range frame's depth bytes into `out` (width × height values, row by row).
+[[nodiscard]] ProtocolResult<void> decodeRangeDepth(const RangeFrameView& frame,
+                                                    std::span<std::uint16_t> out);
+
+}  // namespace smx::protocol

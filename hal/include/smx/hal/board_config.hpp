@@ -1,0 +1,58 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "smx/hal/camera.hpp"
+
+// A board as its board.json describes it (docs/boards.md): which backend it needs, its rig,
+// cameras, projector trigger lines by role, network and depth unit. Plain data; the firmware's
+// board loader fills and validates it, a backend's createBoardHal() consumes it.
+namespace smx::hal {
+
+struct CameraConfig {
+  std::string id;      // the rig's camera id
+  std::string device;  // "/dev/video0", "libcamera:<name>", or "sim" on the simulated board
+  CameraFormat format;
+  int buffers = 4;  // streaming buffers, 2..32
+};
+
+struct TriggerLineConfig {
+  std::string role;  // the rig's projector id
+  std::string chip;  // "gpiochip0" (linux); ignored by the simulated board
+  unsigned offset = 0;
+  bool activeLow = false;
+};
+
+struct TriggerConfig {
+  std::vector<TriggerLineConfig> lines;  // in the rig's projector order
+  std::int64_t leadNs = 0;               // lines active this long before the exposure starts
+};
+
+struct NetworkConfig {
+  std::string bindAddress = "0.0.0.0";
+  std::uint16_t port = 5555;  // 0: any free port (tests)
+};
+
+// Only the simulated board: what its cameras see.
+struct SimBoardConfig {
+  std::string scene;                // a named scene or a scene.json path; rendered live
+  std::filesystem::path replayDir;  // or: replay <dir>/<camera-id>_<n>.png in a loop
+  std::uint64_t seed = 1;
+};
+
+struct BoardConfig {
+  std::string name;
+  std::string backend;  // "sim" or "linux": which HAL the firmware must be built with
+  std::filesystem::path directory;
+  std::filesystem::path rigPath;
+  std::vector<CameraConfig> cameras;  // in the rig's camera order
+  TriggerConfig trigger;
+  NetworkConfig network;
+  double depthUnitM = 1e-4;
+  SimBoardConfig sim;
+};
+
+}  // namespace smx::hal

@@ -1,0 +1,43 @@
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <expected>
+#include <span>
+#include <string>
+
+#include "smx/net/unique_fd.hpp"
+
+// The host end of the link: a TCP connection to a device. Host tool code: errors are messages
+// that name the device and the system's reason.
+namespace smx::net {
+
+struct DeviceAddress {
+  std::string host;
+  std::uint16_t port = 0;
+};
+
+// "HOST" or "HOST:PORT" (defaultPort when absent); "[v6]:port" is not supported yet.
+[[nodiscard]] std::expected<DeviceAddress, std::string> parseDeviceAddress(
+    const std::string& text, std::uint16_t defaultPort);
+
+class TcpClient {
+ public:
+  [[nodiscard]] static std::expected<TcpClient, std::string> connect(
+      const DeviceAddress& address, std::chrono::milliseconds timeout);
+
+  // Sends everything or fails (peer closed, timeout while the peer reads nothing).
+  [[nodiscard]] std::expected<void, std::string> sendAll(std::span<const std::byte> bytes,
+                                                         std::chrono::milliseconds timeout);
+  // Waits at most `timeout`; 0 bytes: nothing arrived in time. Closed by the peer: an error.
+  [[nodiscard]] std::expected<std::size_t, std::string> receiveSome(
+      std::span<std::byte> bytes, std::chrono::milliseconds timeout);
+  void close() { fd_.reset(); }
+
+ private:
+  explicit TcpClient(UniqueFd fd) : fd_(std::move(fd)) {}
+  UniqueFd fd_;
+};
+
+}  // namespace smx::net
