@@ -18,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "smx/config/field_reader.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_keys.hpp"
 #include "smx/config/json_paths.hpp"
@@ -104,151 +105,14 @@ constexpr config::DocumentSpec kSceneDocument = {
 
 // --- Reading scene values ---
 
-enum class Range : std::uint8_t { kAny, kPositive, kNonNegative, kFraction };
+using config::Range;
 
-// Reads values into a scene whose members already hold the defaults, and keeps the first
-// problem: once one is found the remaining reads do nothing, so the reading code stays a plain
-// sequence and the report is the first problem in reading order.
-class Reader {
+// The generic reads, plus the scene's vectors and matrices (Eigen).
+class Reader : public config::FieldReader {
  public:
-  [[nodiscard]] bool ok() const { return !error_.has_value(); }
   [[nodiscard]] std::unexpected<SceneError> error() const {
-    return std::unexpected(error_.value_or(SceneError{}));
-  }
-
-  void fail(std::string field, std::string problem) {
-    if (!error_) {
-      error_ = SceneError{{}, std::move(field), std::move(problem)};
-    }
-  }
-
-  // `v` must be an object (`what`, for the message) holding only `allowed` keys.
-  bool object(const Json& v, const std::string& path, std::string_view what, Keys allowed) {
-    if (!ok()) {
-      return false;
-    }
-    if (!v.is_object()) {
-      fail(path, "must be an object (" + std::string(what) + "), got " + describe(v));
-      return false;
-    }
-    if (const auto key = config::unknownKey(v, allowed)) {
-      fail(path, config::unknownKeyProblem(*key, allowed));
-      return false;
-    }
-    return true;
-  }
-
-  // The value of an optional key, or nullptr when it is absent (or reading has failed).
-  [[nodiscard]] const Json* find(const Json& obj, std::string_view key) const {
-    if (!ok()) {
-      return nullptr;
-    }
-    const auto it = obj.find(key);
-    return it == obj.end() ? nullptr : &*it;
-  }
-
-  std::optional<double> number(const Json& v, const std::string& path, Range range) {
-    if (!ok()) {
-      return std::nullopt;
-    }
-    if (!v.is_number()) {
-      fail(path, "must be a number, got " + describe(v));
-      return std::nullopt;
-    }
-    const double d = v.get<double>();
-    const std::string got = ", got " + formatNumber(d);
-    if (!std::isfinite(d)) {
-      fail(path, "must be a finite number" + got);
-    } else if (range == Range::kPositive && !(d > 0)) {
-      fail(path, "must be positive" + got);
-    } else if (range == Range::kNonNegative && d < 0) {
-      fail(path, "must not be negative" + got);
-    } else if (range == Range::kFraction && (d < 0 || d > 1)) {
-      fail(path, "must be between 0 and 1" + got);
-    } else {
-      return d;
-    }
-    return std::nullopt;
-  }
-
-  void number(const Json& obj, const std::string& path, std::string_view key, Range range,
-              double& out) {
-    if (const Json* v = find(obj, key); v != nullptr) {
-      out = number(*v, member(path, key), range).value_or(out);
-    }
-  }
-
-  // An integer lo ... hi (2.0 is accepted as 2: it is an integer, only written differently).
-  void integer(const Json& obj, const std::string& path, std::string_view key, int lo, int hi,
-               std::string_view what, int& out) {
-    const Json* v = find(obj, key);
-    if (v == nullptr) {
-      return;
-    }
-    const std::string at = member(path, key);
-    const auto d = number(*v, at, Range::kAny);
-    if (!d) {
-      return;
-    }
-    if (*d != std::floor(*d) || *d < lo || *d > hi) {
-      fail(at, "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) +
-                   " (" + std::string(what) + "), got " + formatNumber(*d));
-      return;
-    }
-    out = static_cast<int>(*d);
-  }
-
-  void boolean(const Json& obj, const std::string& path, std::string_view key, bool& out) {
-    if (const Json* v = find(obj, key); v != nullptr) {
-      if (!v->is_boolean()) {
-        fail(member(path, key), "must be true or false, got " + describe(*v));
-        return;
-      }
-      out = v->get<bool>();
-    }
-  }
-
-  // A required, non-empty string.
-  std::optional<std::string> text(const Json& obj, const std::string& path, std::string_view key,
-                                  std::string_view missingHint) {
-    if (!ok()) {
-      return std::nullopt;
-    }
-    const std::string at = member(path, key);
-    const Json* v = find(obj, key);
-    if (v == nullptr) {
-      fail(at, "required field is missing; " + std::string(missingHint));
-    } else if (!v->is_string()) {
-      fail(at, "must be a string, got " + describe(*v));
-    } else if (v->get_ref<const std::string&>().empty()) {
-      fail(at, "must not be empty");
-    } else {
-      return v->get<std::string>();
-    }
-    return std::nullopt;
-  }
-
-  // An array of N numbers (`what` says what they are, for the message).
-  template <std::size_t N>
-  std::optional<std::array<double, N>> numbers(const Json& v, const std::string& path,
-                                               std::string_view what, Range range) {
-    if (!ok()) {
-      return std::nullopt;
-    }
-    if (!v.is_array() || v.size() != N) {
-      fail(path, "must be an array of " + std::to_string(N) + " numbers (" + std::string(what) +
-                     "), got " + describe(v));
-      return std::nullopt;
-    }
-    std::array<double, N> out{};
-    for (std::size_t i = 0; i < N; ++i) {
-      const auto d = number(v[i], element(path, i), range);
-      if (!d) {
-        return std::nullopt;
-      }
-      out[i] = *d;
-    }
-    return out;
+    const auto e = firstError().value_or(config::FieldError{});
+    return std::unexpected(SceneError{{}, e.field, e.problem});
   }
 
   void vec3(const Json& obj, const std::string& path, std::string_view key, std::string_view what,
@@ -268,9 +132,6 @@ class Reader {
       }
     }
   }
-
- private:
-  std::optional<SceneError> error_;
 };
 
 // sin and cos of an angle in degrees; exact at multiples of 90° so that quarter turns give

@@ -1,0 +1,292 @@
+#include "smx/board/board_json.hpp"
+
+#include <arpa/inet.h>
+
+#include <array>
+#include <exception>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <utility>
+
+#include "smx/config/field_reader.hpp"
+#include "smx/config/json_reader.hpp"
+#include "smx/protocol/rig_json.hpp"
+
+namespace smx::board {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using config::describe;
+using config::element;
+using config::jsonQuote;
+using config::member;
+using config::Range;
+
+constexpr std::array<std::string_view, 10> kTopKeys = {
+    "format",  "name",     "hal",     "rig", "depth_unit_m",
+    "cameras", "triggers", "network", "sim", "description"};
+constexpr std::array<std::string_view, 5> kCameraKeys = {"id", "device", "pixel_format", "fps",
+                                                         "buffers"};
+constexpr std::array<std::string_view, 2> kTriggerKeys = {"lead_us", "lines"};
+constexpr std::array<std::string_view, 4> kLineKeys = {"role", "chip", "line", "active_low"};
+constexpr std::array<std::string_view, 2> kNetworkKeys = {"bind", "port"};
+constexpr std::array<std::string_view, 3> kSimKeys = {"scene", "replay", "seed"};
+constexpr std::array<std::string_view, 2> kHals = {"sim", "linux"};
+constexpr std::array<std::string_view, 3> kPixelFormats = {"RGB24", "BGR24", "YUYV"};
+
+constexpr std::array<config::FormatHint, 2> kOtherFormats = {
+    {{"stripemux-rig/", " (this is a rig.json; a board names its rig in \"rig\")"},
+     {"stripemux-scene/", " (this is a scene.json, not a board)"}}};
+constexpr config::DocumentSpec kBoardDocument = {.name = "board.json",
+                                                 .format = kBoardFormat,
+                                                 .topKeys = kTopKeys,
+                                                 .maxBytes = std::size_t{1} << 16U,
+                                                 .sizeNote = "",
+                                                 .nestingNeeded = 4,
+                                                 .maxNesting = 16,
+                                                 .otherFormats = kOtherFormats};
+
+class Reader : public config::FieldReader {
+ public:
+  // One of `allowed` words.
+  std::optional<std::string> word(const Json& obj, const std::string& path, std::string_view key,
+                                  config::Keys allowed) {
+    auto value = text(obj, path, key, "one of: " + config::joined(allowed));
+    if (value && std::ranges::find(allowed, *value) == allowed.end()) {
+      fail(member(path, key), jsonQuote(*value) + " is not one of: " + config::joined(allowed));
+      return std::nullopt;
+    }
+    return value;
+  }
+
+  // A required array of objects of `allowed` keys.
+  const Json* objects(const Json& obj, const std::string& path, std::string_view key,
+                      std::string_view what) {
+    const Json* v = find(obj, key);
+    if (!ok()) {
+      return nullptr;
+    }
+    if (v == nullptr || !v->is_array()) {
+      fail(member(path, key), "must be an array of " + std::string(what) +
+                                  (v == nullptr ? ", but is missing" : ", got " + describe(*v)));
+      return nullptr;
+    }
+    return v;
+  }
+};
+
+hal::PixelFormat pixelFormat(std::string_view name) {
+  if (name == "BGR24") {
+    return hal::PixelFormat::kBgr24;
+  }
+  return name == "YUYV" ? hal::PixelFormat::kYuyv : hal::PixelFormat::kRgb24;
+}
+
+void readCameras(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardConfig& board) {
+  const Json* cameras = r.objects(doc, "", "cameras", "cameras, one per camera of the rig");
+  if (cameras == nullptr) {
+    return;
+  }
+  if (cameras->size() != rig.cameras.size()) {
+    r.fail("cameras", "has " + std::to_string(cameras->size()) + " entries but the rig has " +
+                          std::to_string(rig.cameras.size()) + " cameras");
+    return;
+  }
+  for (std::size_t i = 0; i < cameras->size() && r.ok(); ++i) {
+    const std::string at = element("cameras", i);
+    const Json& v = (*cameras)[i];
+    if (!r.object(v, at, "a camera", kCameraKeys)) {
+      return;
+    }
+    hal::CameraConfig camera;
+    camera.id = r.text(v, at, "id", "the rig's camera id").value_or("");
+    if (r.ok() && camera.id != rig.cameras[i].id) {
+      r.fail(member(at, "id"), jsonQuote(camera.id) + " is not the rig's camera " +
+                                   std::to_string(i) + " (" + jsonQuote(rig.cameras[i].id) +
+                                   "); list the cameras in the rig's order");
+    }
+    camera.device = r.text(v, at, "device", "e.g. \"/dev/video0\" or \"sim\"").value_or("");
+    camera.format.pixelFormat =
+        pixelFormat(r.word(v, at, "pixel_format", kPixelFormats).value_or(""));
+    camera.format.width = rig.cameras[i].width;
+    camera.format.height = rig.cameras[i].height;
+    r.integer(v, at, "fps", 1, 240, "frames per second", camera.format.fps);
+    r.integer(v, at, "buffers", 2, 32, "streaming buffers", camera.buffers);
+    board.cameras.push_back(std::move(camera));
+  }
+}
+
+void readTriggers(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardConfig& board) {
+  const Json* triggers = r.find(doc, "triggers");
+  if (!r.ok()) {
+    return;
+  }
+  if (triggers == nullptr) {
+    r.fail("triggers", "required field is missing; one trigger line per projector of the rig");
+    return;
+  }
+  if (!r.object(*triggers, "triggers", "trigger lines", kTriggerKeys)) {
+    return;
+  }
+  int leadUs = 0;
+  r.integer(*triggers, "triggers", "lead_us", 0, 100'000, "microseconds", leadUs);
+  board.trigger.leadNs = std::int64_t{leadUs} * 1000;
+  const Json* lines = r.objects(*triggers, "triggers", "lines", "trigger lines");
+  if (lines == nullptr) {
+    return;
+  }
+  if (lines->size() != rig.projectors.size()) {
+    r.fail("triggers.lines", "has " + std::to_string(lines->size()) + " lines but the rig has " +
+                                 std::to_string(rig.projectors.size()) + " projectors");
+    return;
+  }
+  for (std::size_t i = 0; i < lines->size() && r.ok(); ++i) {
+    const std::string at = element("triggers.lines", i);
+    const Json& v = (*lines)[i];
+    if (!r.object(v, at, "a trigger line", kLineKeys)) {
+      return;
+    }
+    hal::TriggerLineConfig line;
+    line.role = r.text(v, at, "role", "the rig's projector id").value_or("");
+    if (r.ok() && line.role != rig.projectors[i].id) {
+      r.fail(member(at, "role"), jsonQuote(line.role) + " is not the rig's projector " +
+                                     std::to_string(i) + " (" + jsonQuote(rig.projectors[i].id) +
+                                     "); list the lines in the rig's projector order");
+    }
+    line.chip = r.text(v, at, "chip", "the GPIO chip, e.g. \"gpiochip0\"").value_or("");
+    int offset = -1;
+    r.integer(v, at, "line", 0, 511, "the line offset on the chip", offset);
+    if (r.ok() && offset < 0) {
+      r.fail(member(at, "line"), "required field is missing; the line offset on the chip");
+    }
+    line.offset = static_cast<unsigned>(offset < 0 ? 0 : offset);
+    r.boolean(v, at, "active_low", line.activeLow);
+    for (const auto& other : board.trigger.lines) {
+      if (r.ok() && other.chip == line.chip && other.offset == line.offset) {
+        r.fail(member(at, "line"), "line " + std::to_string(line.offset) + " of " + line.chip +
+                                       " is already the line of " + jsonQuote(other.role));
+      }
+    }
+    board.trigger.lines.push_back(std::move(line));
+  }
+}
+
+void readNetwork(Reader& r, const Json& doc, hal::BoardConfig& board) {
+  const Json* network = r.find(doc, "network");
+  if (network == nullptr || !r.object(*network, "network", "the network", kNetworkKeys)) {
+    return;
+  }
+  if (r.find(*network, "bind") != nullptr) {
+    board.network.bindAddress = r.text(*network, "network", "bind", "").value_or("");
+    in_addr parsed{};
+    if (r.ok() && ::inet_pton(AF_INET, board.network.bindAddress.c_str(), &parsed) != 1) {
+      r.fail("network.bind", jsonQuote(board.network.bindAddress) +
+                                 " is not an IPv4 address (\"0.0.0.0\": every interface)");
+    }
+  }
+  int port = board.network.port;
+  r.integer(*network, "network", "port", 0, 65535, "TCP port; 0: any free one", port);
+  board.network.port = static_cast<std::uint16_t>(port);
+}
+
+void readSim(Reader& r, const Json& doc, const fs::path& dir, hal::BoardConfig& board) {
+  const Json* sim = r.find(doc, "sim");
+  if (!r.ok()) {
+    return;
+  }
+  if (board.backend != "sim") {
+    if (sim != nullptr) {
+      r.fail("sim", "only a board with \"hal\": \"sim\" has a sim section");
+    }
+    return;
+  }
+  if (sim == nullptr) {
+    r.fail("sim",
+           "required field is missing; the simulated board needs a scene or a replay "
+           "folder");
+    return;
+  }
+  if (!r.object(*sim, "sim", "what the simulated cameras see", kSimKeys)) {
+    return;
+  }
+  if (r.find(*sim, "scene") != nullptr) {
+    board.sim.scene = r.text(*sim, "sim", "scene", "").value_or("");
+  }
+  if (r.find(*sim, "replay") != nullptr) {
+    board.sim.replayDir = dir / r.text(*sim, "sim", "replay", "").value_or("");
+  }
+  if (r.ok() && board.sim.scene.empty() == board.sim.replayDir.empty()) {
+    r.fail("sim",
+           "give exactly one of \"scene\" (render live) and \"replay\" (a folder of "
+           "frames)");
+  }
+  double seed = 1;
+  r.number(*sim, "sim", "seed", Range::kNonNegative, seed);
+  board.sim.seed = static_cast<std::uint64_t>(seed);
+}
+
+std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs::path& dir) {
+  auto parsed = config::parseDocument(text, kBoardDocument);
+  if (!parsed) {
+    return std::unexpected(BoardError{{}, parsed.error().field, parsed.error().problem});
+  }
+  const Json& doc = *parsed;
+  Reader r;
+  Board out;
+  hal::BoardConfig& board = out.config;
+  board.directory = dir;
+  board.name = r.text(doc, "", "name", "the board's name, e.g. \"rpi4\"").value_or("");
+  board.backend = r.word(doc, "", "hal", kHals).value_or("");
+  const auto rigFile = r.text(doc, "", "rig", "the rig.json file, relative to the board folder");
+  if (rigFile) {
+    board.rigPath = dir / *rigFile;
+    auto rig = protocol::loadRig(board.rigPath);
+    if (!rig) {
+      r.fail("rig", "cannot use the rig: " + rig.error().message());
+    } else {
+      out.rig = std::move(*rig);
+    }
+  }
+  r.number(doc, "", "depth_unit_m", Range::kPositive, board.depthUnitM);
+  if (r.ok() && (board.depthUnitM < 1e-6 || board.depthUnitM > 1e-2)) {
+    r.fail("depth_unit_m", "must be from 1e-06 (1 um) to 0.01 (1 cm), got " +
+                               config::formatNumber(board.depthUnitM));
+  }
+  if (r.ok()) {
+    readCameras(r, doc, out.rig, board);
+    readTriggers(r, doc, out.rig, board);
+    readNetwork(r, doc, board);
+    readSim(r, doc, dir, board);
+  }
+  if (!r.ok()) {
+    const auto& e = *r.firstError();
+    return std::unexpected(BoardError{{}, e.field, e.problem});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string BoardError::message() const {
+  return config::errorMessage(file, field, problem);
+}
+
+std::expected<Board, BoardError> parseBoard(std::string_view text, const fs::path& dir) {
+  try {
+    return parseBoardImpl(text, dir);
+  } catch (const std::exception& e) {
+    return std::unexpected(BoardError{{}, {}, std::string("cannot read the board: ") + e.what()});
+  }
+}
+
+std::expected<Board, BoardError> loadBoard(const fs::path& path) {
+  std::error_code ec;
+  const fs::path file = fs::is_directory(path, ec) ? path / "board.json" : path;
+  return config::loadDocument(file, kBoardDocument, [&](const std::string& text) {
+    return parseBoard(text, file.parent_path());
+  });
+}
+
+}  // namespace smx::board

@@ -1,0 +1,93 @@
+#include "smx/board/board_json.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace smx::board {
+namespace {
+
+const std::filesystem::path kBoards = std::filesystem::path(SMX_SOURCE_DIR) / "boards";
+
+// The sim board's text with one substitution, parsed against the sim board folder.
+std::expected<Board, BoardError> simBoardWith(const std::string& from, const std::string& to) {
+  std::ifstream in(kBoards / "sim" / "board.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) {
+    text.replace(at, from.size(), to);
+  }
+  return parseBoard(text, kBoards / "sim");
+}
+
+void expectError(const std::expected<Board, BoardError>& board, const std::string& field,
+                 const std::string& problemPart) {
+  ASSERT_FALSE(board.has_value());
+  EXPECT_EQ(board.error().field, field) << board.error().message();
+  EXPECT_NE(board.error().problem.find(problemPart), std::string::npos) << board.error().message();
+}
+
+TEST(BoardJson, TheShippedBoardsLoad) {
+  const auto sim = loadBoard(kBoards / "sim");
+  ASSERT_TRUE(sim.has_value()) << sim.error().message();
+  EXPECT_EQ(sim->config.backend, "sim");
+  ASSERT_EQ(sim->config.cameras.size(), 2U);
+  EXPECT_EQ(sim->config.cameras[1].id, "cam1");
+  EXPECT_EQ(sim->config.cameras[0].format.width, 640);
+  ASSERT_EQ(sim->config.trigger.lines.size(), 2U);
+  EXPECT_EQ(sim->config.trigger.leadNs, 200'000);
+  EXPECT_EQ(sim->config.sim.scene, "turntable");
+  EXPECT_EQ(sim->rig.projectors.size(), 2U);
+
+  const auto rpi = loadBoard(kBoards / "rpi4" / "board.json");
+  ASSERT_TRUE(rpi.has_value()) << rpi.error().message();
+  EXPECT_EQ(rpi->config.backend, "linux");
+  EXPECT_EQ(rpi->config.cameras[0].device, "/dev/video0");
+  EXPECT_EQ(rpi->config.cameras[0].format.pixelFormat, hal::PixelFormat::kYuyv);
+  EXPECT_EQ(rpi->config.trigger.lines[1].offset, 27U);
+  EXPECT_EQ(rpi->config.network.bindAddress, "0.0.0.0");
+}
+
+TEST(BoardJson, ErrorsNameTheField) {
+  expectError(simBoardWith(R"("id": "cam1")", R"("id": "camX")"), "cameras[1].id",
+              "is not the rig's camera 1");
+  expectError(simBoardWith(R"("pixel_format": "RGB24", "fps": 30, "buffers": 4},)",
+                           R"("pixel_format": "NV12", "fps": 30, "buffers": 4},)"),
+              "cameras[0].pixel_format", "is not one of: RGB24, BGR24, YUYV");
+  expectError(simBoardWith(R"("fps": 30, "buffers": 4}
+  ])",
+                           R"("fps": 30, "buffers": 64}
+  ])"),
+              "cameras[1].buffers", "from 2 to 32");
+  expectError(simBoardWith(R"({"role": "proj1", "chip": "sim", "line": 1})",
+                           R"({"role": "proj1", "chip": "sim", "line": 0})"),
+              "triggers.lines[1].line", "already the line of \"proj0\"");
+  expectError(simBoardWith(R"(,
+      {"role": "proj1", "chip": "sim", "line": 1})",
+                           ""),
+              "triggers.lines", "has 1 lines but the rig has 2 projectors");
+  expectError(simBoardWith(R"("bind": "127.0.0.1")", R"("bind": "localhost")"), "network.bind",
+              "is not an IPv4 address");
+  expectError(simBoardWith(R"("rig": "rig_2proj_2cam.json")", R"("rig": "missing.json")"), "rig",
+              "missing.json");
+  expectError(simBoardWith(R"("hal": "sim")", R"("hal": "linux")"), "sim",
+              "only a board with \"hal\": \"sim\"");
+  expectError(simBoardWith(R"("scene": "turntable")", R"("scene": "turntable", "replay": "x")"),
+              "sim", "exactly one of");
+  expectError(simBoardWith(R"("depth_unit_m")", R"("depth_units_m")"), "",
+              "did you mean \"depth_unit_m\"");
+  expectError(simBoardWith("stripemux-board/1", "stripemux-rig/1"), "format", "this is a rig.json");
+}
+
+TEST(BoardJson, AMissingFileIsNamed) {
+  const auto board = loadBoard(kBoards / "no-such-board");
+  ASSERT_FALSE(board.has_value());
+  EXPECT_NE(board.error().message().find("no-such-board"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace smx::board
