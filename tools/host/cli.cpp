@@ -16,6 +16,8 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addSimCommand(app, io, exitCode);
   addDemuxCommand(app, io, exitCode);
   addDecodeCommand(app, io, exitCode);
+  addInfoCommand(app, io, exitCode);
+  addStreamCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "smx/protocol/rig_json.hpp"
+#include "smx/sim/named_scenes.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/renderer.hpp"
@@ -34,44 +35,6 @@ struct SimOptions {
   std::string lit = "all";
   bool noTruth = false;
 };
-
-// Named scenes live in hal/sim/scenes/<name>.json; STRIPEMUX_SCENES overrides the folder.
-fs::path sceneDir() {
-  // NOLINTNEXTLINE(concurrency-mt-unsafe): read once, before any thread exists.
-  if (const char* env = std::getenv("STRIPEMUX_SCENES"); env != nullptr && *env != '\0') {
-    return env;
-  }
-  return SMX_SCENE_DIR;
-}
-
-std::vector<std::string> namedScenes() {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(sceneDir(), ec)) {
-    if (entry.path().extension() == ".json") {
-      names.push_back(entry.path().stem().string());
-    }
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-// A path if it names a file, else a named scene.
-std::expected<fs::path, std::string> resolveScene(const std::string& arg) {
-  if (fs::exists(arg) || arg.find('/') != std::string::npos || arg.ends_with(".json")) {
-    return fs::path(arg);
-  }
-  const auto named = sceneDir() / (arg + ".json");
-  if (fs::exists(named)) {
-    return named;
-  }
-  std::string known;
-  for (const auto& n : namedScenes()) {
-    known += (known.empty() ? "" : ", ") + n;
-  }
-  return std::unexpected("--scene " + arg + ": no such file and no named scene of that name" +
-                         " (named scenes: " + known + ")");
-}
 
 std::expected<std::vector<bool>, std::string> parseLit(const std::string& spec,
                                                        const algo::Rig& rig) {
@@ -162,7 +125,7 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
   if (!rig) {
     return fail(kExitBadInput, rig.error().message());
   }
-  const auto scenePath = resolveScene(opts.scene);
+  const auto scenePath = sim::resolveScene(opts.scene);
   if (!scenePath) {
     return fail(kExitBadInput, scenePath.error());
   }

@@ -49,6 +49,11 @@ class Camera {
   // Waits at most timeoutNs for the next frame.
   [[nodiscard]] virtual HalResult<CameraFrame> acquire(std::int64_t timeoutNs) = 0;
   [[nodiscard]] virtual HalResult<void> release(const CameraFrame& frame) = 0;
+  // After kDisconnected: tries to reopen the device and return to the state it was in
+  // (configured, streaming). kDisconnected while it is still gone.
+  [[nodiscard]] virtual HalResult<void> recover() {
+    return halFail(HalErrc::kNotSupported, "this camera cannot recover");
+  }
 
   [[nodiscard]] virtual CameraState state() const = 0;
   [[nodiscard]] virtual std::string_view id() const = 0;  // the rig's camera id

@@ -1,0 +1,108 @@
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <expected>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "smx/algo/camera_pipeline.hpp"
+#include "smx/board/board_json.hpp"
+#include "smx/device/send_queue.hpp"
+#include "smx/hal/board_hal.hpp"
+#include "smx/protocol/messages.hpp"
+#include "smx/protocol/stream_parser.hpp"
+
+// The appliance (docs/firmware.md): a capture loop that triggers the projectors, captures every
+// camera, runs the pipeline and queues range frames, and a network loop that serves one host
+// (hello → capabilities, start/stop stream, statistics) and sends the queue. Each loop runs on
+// its own thread; after create() neither allocates.
+namespace smx::device {
+
+struct DeviceOptions {
+  std::string firmwareVersion = "0.0.0";
+  std::size_t queueSlots = 4;  // range frames waiting for the host, per device
+  std::int64_t acquireTimeoutNs = 2'000'000'000;
+  algo::PipelineOptions pipeline;  // depthUnitM is taken from the board
+};
+
+// Counters, readable from any thread while the loops run.
+struct DeviceCounters {
+  std::atomic<std::uint64_t> framesCaptured = 0;  // camera frames acquired
+  std::atomic<std::uint64_t> framesDecoded = 0;   // range frames computed
+  std::atomic<std::uint64_t> framesQueued = 0;    // range frames handed to the send queue
+  std::atomic<std::uint64_t> framesSent = 0;      // range frames fully given to the link
+  std::atomic<std::uint64_t> captureErrors = 0;   // timeouts, lost cameras, failed frames
+  std::atomic<std::uint64_t> protocolErrors = 0;  // bad messages from the host
+  std::atomic<std::uint64_t> connections = 0;     // hosts served so far
+  std::atomic<std::uint64_t> decodeTimeUsTotal = 0;
+  std::atomic<std::uint32_t> decodeTimeUsLast = 0;
+};
+
+class Device {
+ public:
+  // Init: pipelines and their arenas, the send queue, the capabilities message.
+  [[nodiscard]] static std::expected<std::unique_ptr<Device>, std::string> create(
+      const board::Board& board, hal::Hal hal, const DeviceOptions& options);
+  ~Device();
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  // One capture: trigger, acquire every camera, decode, queue (while a host streams). A camera
+  // error is counted and returned; the caller goes on with the next capture.
+  [[nodiscard]] hal::HalResult<void> captureOnce();
+  // Runs captureOnce() until stop is set.
+  void runCapture(const std::atomic<bool>& stop);
+  // One round of the network loop: accept, receive and answer, send; waits at most timeoutNs.
+  void serviceNetwork(std::int64_t timeoutNs);
+  void runNetwork(const std::atomic<bool>& stop);
+
+  [[nodiscard]] const DeviceCounters& counters() const { return counters_; }
+  [[nodiscard]] std::uint64_t framesDropped() const { return queue_.dropped(); }
+  [[nodiscard]] protocol::Statistics statistics() const;
+  [[nodiscard]] bool streaming() const { return streaming_; }
+  [[nodiscard]] std::size_t arenaBytes() const;
+  [[nodiscard]] const hal::Hal& hal() const { return hal_; }
+
+ private:
+  struct CameraSlot {
+    std::vector<std::byte> memory;
+    std::unique_ptr<algo::Arena> arena;
+    std::optional<algo::CameraPipeline> pipeline;
+  };
+
+  Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options);
+  void queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs);
+  void onMessage(const protocol::Message& message);
+  void sendControl(std::span<const std::byte> message);
+  void dropConnection();
+  void pumpSend();
+
+  hal::Hal hal_;
+  DeviceOptions options_;
+  std::uint32_t depthUnitNm_;
+  std::uint32_t allProjectorsMask_;
+  std::int64_t leadNs_;
+  std::int64_t startNs_;
+  std::vector<CameraSlot> cameras_;
+  std::vector<hal::CameraFrame> frames_;  // this capture's borrowed frames, per camera
+  std::uint64_t captureNumber_ = 0;
+  DeviceCounters counters_;
+  SendQueue queue_;
+  std::atomic<bool> streaming_ = false;
+  std::atomic<protocol::Compression> compression_ = protocol::Compression::kRvl;
+
+  // Network thread only.
+  protocol::StreamParser parser_;
+  std::vector<std::byte> capabilities_;  // encoded once at create()
+  std::vector<std::byte> control_;       // replies waiting to be sent before the next frame
+  std::size_t controlSize_ = 0;
+  std::span<const std::byte> sending_;  // the message being sent (control or queue slot)
+  bool sendingFrame_ = false;
+  std::size_t sent_ = 0;
+  bool helloSeen_ = false;
+};
+
+}  // namespace smx::device

@@ -1,0 +1,194 @@
+// The network loop: one host at a time, control replies before queued frames, nothing blocks.
+#include <cstring>
+
+#include "smx/device/device.hpp"
+
+namespace smx::device {
+
+namespace {
+constexpr std::int64_t kNetworkTickNs = 2'000'000;  // bounds the latency of a queued frame
+}  // namespace
+
+protocol::Statistics Device::statistics() const {
+  const std::uint64_t decoded = counters_.framesDecoded;
+  return protocol::Statistics{
+      .uptimeMs = static_cast<std::uint64_t>((hal_.clock.nowNs() - startNs_) / 1'000'000),
+      .framesCaptured = counters_.framesCaptured,
+      .framesDecoded = decoded,
+      .framesSent = counters_.framesSent,
+      .framesDropped = queue_.dropped(),
+      .captureErrors = counters_.captureErrors,
+      .protocolErrors = counters_.protocolErrors,
+      .decodeTimeUsLast = counters_.decodeTimeUsLast,
+      .decodeTimeUsMean =
+          static_cast<std::uint32_t>(decoded == 0 ? 0 : counters_.decodeTimeUsTotal / decoded)};
+}
+
+void Device::sendControl(std::span<const std::byte> message) {
+  if (control_.size() - controlSize_ < message.size()) {
+    ++counters_.protocolErrors;  // a host that asks faster than it reads loses replies
+    return;
+  }
+  std::memcpy(control_.data() + controlSize_, message.data(), message.size());
+  controlSize_ += message.size();
+}
+
+void Device::onMessage(const protocol::Message& message) {
+  using protocol::MessageType;
+  std::array<std::byte, 512> reply{};
+  const auto refuse = [&](protocol::ErrorCode code, const char* text) {
+    ++counters_.protocolErrors;
+    if (const auto error = protocol::encode(protocol::ErrorMessage{code, text}, reply)) {
+      sendControl(*error);
+    }
+  };
+  switch (message.type) {
+    case MessageType::kHello:
+      if (!protocol::decodeHello(message.payload)) {
+        refuse(protocol::ErrorCode::kBadRequest, "malformed hello");
+        return;
+      }
+      helloSeen_ = true;
+      sendControl(capabilities_);
+      return;
+    case MessageType::kStartStream: {
+      const auto start = protocol::decodeStartStream(message.payload);
+      if (!start) {
+        refuse(protocol::ErrorCode::kBadRequest, start.error().message);
+      } else if (!helloSeen_) {
+        refuse(protocol::ErrorCode::kBadRequest, "start-stream before hello");
+      } else {
+        compression_ = start->compression;
+        streaming_ = true;
+      }
+      return;
+    }
+    case MessageType::kStopStream:
+      streaming_ = false;
+      queue_.clear();
+      [[fallthrough]];
+    case MessageType::kGetStatistics:
+      if (!protocol::decodeEmpty(message.payload)) {
+        refuse(protocol::ErrorCode::kBadRequest, "payload on a message that has none");
+      } else if (const auto stats = protocol::encode(statistics(), reply)) {
+        sendControl(*stats);
+      }
+      return;
+    default:
+      refuse(protocol::ErrorCode::kBadRequest, "that message type is not for the device");
+      return;
+  }
+}
+
+void Device::dropConnection() {
+  hal_.link.disconnect();
+  streaming_ = false;
+  if (sendingFrame_ && !sending_.empty()) {
+    queue_.finishSend();  // lost with the connection, not sent
+  }
+  sending_ = {};
+  sendingFrame_ = false;
+  controlSize_ = 0;
+  queue_.clear();
+}
+
+void Device::pumpSend() {
+  while (hal_.link.connected()) {
+    if (sending_.empty()) {
+      sent_ = 0;
+      if (controlSize_ > 0) {
+        sending_ = std::span(control_).first(controlSize_);
+        sendingFrame_ = false;
+      } else if (streaming_) {
+        sending_ = queue_.beginSend();
+        sendingFrame_ = !sending_.empty();
+        if (sending_.empty()) {
+          return;
+        }
+      } else {
+        return;
+      }
+    }
+    const auto n = hal_.link.sendSome(sending_.subspan(sent_));
+    if (!n) {
+      dropConnection();
+      return;
+    }
+    if (*n == 0) {
+      return;  // the host is not reading: the queue absorbs (and drops) what capture makes
+    }
+    sent_ += *n;
+    if (sent_ < sending_.size()) {
+      continue;
+    }
+    if (sendingFrame_) {
+      queue_.finishSend();
+      ++counters_.framesSent;
+    } else {
+      // Replies added while these were sent move to the front.
+      std::memmove(control_.data(), control_.data() + sent_, controlSize_ - sent_);
+      controlSize_ -= sent_;
+    }
+    sending_ = {};
+    sendingFrame_ = false;
+  }
+}
+
+void Device::serviceNetwork(std::int64_t timeoutNs) {
+  hal::Link& link = hal_.link;
+  if (!link.connected()) {
+    if (link.acceptClient(timeoutNs)) {
+      parser_.reset();
+      helloSeen_ = false;
+      ++counters_.connections;
+    }
+    return;
+  }
+  const bool wantWrite =
+      !sending_.empty() || controlSize_ > 0 || (streaming_ && queue_.queued() > 0);
+  (void)link.waitForIo(wantWrite, timeoutNs);
+
+  const auto received = link.receiveSome(parser_.writable(), 0);
+  if (!received) {
+    dropConnection();
+    return;
+  }
+  parser_.commit(*received);
+  while (true) {
+    const auto next = parser_.next();
+    if (!next) {
+      ++counters_.protocolErrors;
+      if (next.error().code == protocol::ProtocolErrc::kUnsupportedVersion) {
+        std::array<std::byte, 256> reply{};
+        if (const auto error =
+                protocol::encode(protocol::ErrorMessage{protocol::ErrorCode::kUnsupportedVersion,
+                                                        "this device speaks protocol version 1"},
+                                 reply)) {
+          sendControl(*error);
+        }
+      }
+      continue;
+    }
+    if (!next->has_value()) {
+      break;
+    }
+    onMessage(**next);
+  }
+  pumpSend();
+}
+
+void Device::runNetwork(const std::atomic<bool>& stop) {
+  while (!stop) {
+    serviceNetwork(kNetworkTickNs);
+  }
+  if (hal_.link.connected()) {
+    // Say goodbye with the counters, as far as the socket takes them now.
+    std::array<std::byte, 256> reply{};
+    if (const auto stats = protocol::encode(statistics(), reply)) {
+      (void)hal_.link.sendSome(*stats);
+    }
+    hal_.link.disconnect();
+  }
+}
+
+}  // namespace smx::device

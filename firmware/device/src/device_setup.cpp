@@ -1,0 +1,106 @@
+// Device::create: everything the loops need, allocated once.
+#include <cmath>
+
+#include "smx/device/device.hpp"
+#include "smx/protocol/rig_json.hpp"
+
+namespace smx::device {
+
+namespace {
+using Fail = std::unexpected<std::string>;
+constexpr std::size_t kControlBytes = 4096;  // replies besides the capabilities
+}  // namespace
+
+Device::Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options)
+    : hal_(hal),
+      options_(options),
+      depthUnitNm_(static_cast<std::uint32_t>(std::lround(board.config.depthUnitM * 1e9))),
+      allProjectorsMask_(static_cast<std::uint32_t>((1U << board.rig.projectors.size()) - 1U)),
+      leadNs_(board.config.trigger.leadNs),
+      startNs_(hal.clock.nowNs()),
+      queue_(options.queueSlots, protocol::rangeFrameBound(board.rig.cameras.front().width,
+                                                           board.rig.cameras.front().height)),
+      parser_(kControlBytes) {}
+
+Device::~Device() = default;
+
+std::expected<std::unique_ptr<Device>, std::string> Device::create(const board::Board& board,
+                                                                   hal::Hal hal,
+                                                                   const DeviceOptions& options) {
+  const algo::Rig& rig = board.rig;
+  if (hal.cameras.size() != rig.cameras.size() || rig.cameras.empty()) {
+    return Fail("the board has " + std::to_string(hal.cameras.size()) +
+                " cameras but its rig has " + std::to_string(rig.cameras.size()));
+  }
+  for (const auto& camera : rig.cameras) {
+    if (camera.width != rig.cameras.front().width || camera.height != rig.cameras.front().height) {
+      return Fail("the cameras of a board must share one image size (camera " + camera.id + ")");
+    }
+  }
+  auto device = std::unique_ptr<Device>(new Device(board, hal, options));
+  algo::PipelineOptions pipelineOptions = options.pipeline;
+  pipelineOptions.depthUnitM = board.config.depthUnitM;
+  device->cameras_.resize(rig.cameras.size());
+  device->frames_.resize(rig.cameras.size());
+  for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
+    const std::string& id = rig.cameras[i].id;
+    const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(i), pipelineOptions);
+    if (!setup) {
+      return Fail("camera " + id + ": " + setup.error());
+    }
+    const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
+    if (!bytes) {
+      return Fail("camera " + id + ": " + bytes.error().message);
+    }
+    CameraSlot& slot = device->cameras_[i];
+    slot.memory.resize(*bytes);
+    slot.arena = std::make_unique<algo::Arena>(slot.memory);
+    auto pipeline = algo::CameraPipeline::create(*setup, *slot.arena);
+    if (!pipeline) {
+      return Fail("camera " + id + ": " + pipeline.error().message);
+    }
+    slot.pipeline.emplace(std::move(*pipeline));
+
+    hal::Camera& camera = *hal.cameras[i];
+    const auto format = camera.configure(board.config.cameras[i].format);
+    if (!format) {
+      return Fail("camera " + id + ": cannot configure " + board.config.cameras[i].device + ": " +
+                  format.error().message);
+    }
+    if (const auto started = camera.start(); !started) {
+      return Fail("camera " + id + ": cannot start streaming: " + started.error().message);
+    }
+  }
+
+  const std::string rigJson = protocol::toJson(rig);
+  const protocol::Capabilities caps{
+      .board = board.config.name,
+      .firmwareVersion = options.firmwareVersion,
+      .halBackend = hal::halBackend(),
+      .depthUnitNm = device->depthUnitNm_,
+      .cameras = static_cast<std::uint8_t>(rig.cameras.size()),
+      .projectors = static_cast<std::uint8_t>(rig.projectors.size()),
+      .width = static_cast<std::uint16_t>(rig.cameras.front().width),
+      .height = static_cast<std::uint16_t>(rig.cameras.front().height),
+      .fps = static_cast<std::uint16_t>(board.config.cameras.front().format.fps),
+      .compressionsMask = (1U << 0U) | (1U << 1U),
+      .rigJson = rigJson};
+  device->capabilities_.resize(protocol::kHeaderBytes + 1024 + rigJson.size());
+  const auto encoded = protocol::encode(caps, device->capabilities_);
+  if (!encoded) {
+    return Fail(std::string("capabilities: ") + encoded.error().message);
+  }
+  device->capabilities_.resize(encoded->size());
+  device->control_.resize(device->capabilities_.size() + kControlBytes);
+  return device;
+}
+
+std::size_t Device::arenaBytes() const {
+  std::size_t total = 0;
+  for (const CameraSlot& slot : cameras_) {
+    total += slot.memory.size();
+  }
+  return total;
+}
+
+}  // namespace smx::device

@@ -1,0 +1,159 @@
+// stripemuxd: the scanner's firmware. Loads a board, opens its devices through the HAL this
+// build links, and serves range images to one host at a time until SIGTERM or SIGINT
+// (docs/firmware.md). Exit codes: 0 stopped cleanly, 1 usage, 2 rejected board, 3 device error.
+#include <pthread.h>
+#include <signal.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cstdio>
+#include <ctime>
+#include <thread>
+
+#include "smx/board/board_json.hpp"
+#include "smx/device/device.hpp"
+#include "smx/hal/board_hal.hpp"
+
+namespace {
+
+using smx::device::Device;
+
+struct Options {
+  std::string board;
+  int port = -1;
+  std::string bind;
+  std::string scene;
+  std::string replay;
+  int fps = 0;
+  std::uint64_t frames = 0;
+  double statusEveryS = 5;
+};
+
+// SIGTERM and SIGINT are blocked in every thread and taken here, so the loops see a plain
+// atomic flag instead of running code in a signal handler.
+void waitForSignal(sigset_t signals, std::atomic<bool>& stop) {
+  const timespec tick{.tv_sec = 0, .tv_nsec = 100'000'000};
+  while (!stop) {
+    if (sigtimedwait(&signals, nullptr, &tick) > 0) {
+      stop = true;
+    }
+  }
+}
+
+void printCounters(const Device& device, const char* prefix) {
+  const auto s = device.statistics();
+  std::printf(
+      "%scaptured %llu, decoded %llu, sent %llu, dropped %llu, capture errors %llu, protocol "
+      "errors %llu, decode %.1f ms/frame\n",
+      prefix, static_cast<unsigned long long>(s.framesCaptured),
+      static_cast<unsigned long long>(s.framesDecoded),
+      static_cast<unsigned long long>(s.framesSent),
+      static_cast<unsigned long long>(s.framesDropped),
+      static_cast<unsigned long long>(s.captureErrors),
+      static_cast<unsigned long long>(s.protocolErrors), s.decodeTimeUsMean / 1000.0);
+  std::fflush(stdout);
+}
+
+int run(const Options& opts) {
+  auto board = smx::board::loadBoard(opts.board);
+  if (!board) {
+    std::fprintf(stderr, "stripemuxd: %s\n", board.error().message().c_str());
+    return 2;
+  }
+  auto& config = board->config;
+  if (opts.port >= 0) {
+    config.network.port = static_cast<std::uint16_t>(opts.port);
+  }
+  if (!opts.bind.empty()) {
+    config.network.bindAddress = opts.bind;
+  }
+  if (!opts.scene.empty() || !opts.replay.empty()) {
+    config.sim.scene = opts.scene;
+    config.sim.replayDir = opts.replay;
+  }
+  for (auto& camera : config.cameras) {
+    camera.format.fps = opts.fps > 0 ? opts.fps : camera.format.fps;
+  }
+  auto hal = smx::hal::createBoardHal(config, board->rig);
+  if (!hal) {
+    std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), hal.error().c_str());
+    return 3;
+  }
+  smx::device::DeviceOptions options;
+  options.firmwareVersion = SMX_VERSION;
+  auto device = Device::create(*board, (*hal)->hal(), options);
+  if (!device) {
+    std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), device.error().c_str());
+    return 3;
+  }
+  const auto& rig = board->rig;
+  std::printf(
+      "stripemuxd %s: board %s (%s HAL), %zu cameras %dx%d, %zu projectors, %zu KiB "
+      "working memory\n",
+      SMX_VERSION, config.name.c_str(), std::string(smx::hal::halBackend()).c_str(),
+      rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
+      rig.projectors.size(), (*device)->arenaBytes() / 1024);
+  std::printf("listening on %s:%u\n", config.network.bindAddress.c_str(),
+              static_cast<unsigned>((*hal)->hal().link.port()));
+  std::fflush(stdout);
+
+  std::atomic<bool> stop = false;
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  std::jthread signalThread(waitForSignal, signals, std::ref(stop));
+  std::jthread network([&] { (*device)->runNetwork(stop); });
+
+  timespec last{};
+  clock_gettime(CLOCK_MONOTONIC, &last);
+  while (!stop) {
+    (void)(*device)->captureOnce();
+    if (opts.frames > 0 &&
+        (*device)->counters().framesCaptured >= opts.frames * rig.cameras.size()) {
+      stop = true;
+    }
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (static_cast<double>(now.tv_sec - last.tv_sec) >= opts.statusEveryS) {
+      printCounters(**device, "status: ");
+      last = now;
+    }
+  }
+  network.join();
+  printCounters(**device, "stopped: ");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Before any thread: every thread inherits the blocked signals.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  CLI::App app{"stripemuxd: the stripemux scanner firmware"};
+  app.set_version_flag("--version", SMX_VERSION);
+  Options opts;
+  app.add_option("--board", opts.board, "board folder or board.json (boards/<name>)")->required();
+  app.add_option("--port", opts.port, "TCP port (overrides the board; 0: any free port)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--bind", opts.bind, "IPv4 address to listen on (overrides the board)");
+  app.add_option("--scene", opts.scene, "simulated board: render this scene");
+  app.add_option("--replay", opts.replay,
+                 "simulated board: replay <dir>/<camera-id>_<n>.png instead of rendering");
+  app.add_option("--fps", opts.fps, "camera frame rate (overrides the board)")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--frames", opts.frames, "stop after this many captures (0: run until SIGTERM)");
+  app.add_option("--status-every", opts.statusEveryS, "seconds between status lines")
+      ->check(CLI::PositiveNumber);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;
+  }
+  return run(opts);
+}

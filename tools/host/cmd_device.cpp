@@ -1,0 +1,363 @@
+// `stripemux info` and `stripemux stream`: talk to a device (docs/cli.md, docs/protocol.md).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "decode_debug.hpp"
+#include "device_client.hpp"
+#include "point_cloud.hpp"
+#include "smx/sim/ply_io.hpp"
+#include "smx/sim/png_io.hpp"
+
+namespace smx::host {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+constexpr auto kConnectTimeout = std::chrono::milliseconds(3000);
+
+struct DeviceOptions {
+  std::string device = "127.0.0.1";
+};
+
+struct StreamOptions {
+  std::string device = "127.0.0.1";
+  fs::path out;
+  int frames = 10;
+  std::string compression = "rvl";
+  double timeoutS = 30;
+  bool noPly = false;
+};
+
+bool isLoopback(const std::string& address) {
+  return address.starts_with("127.") || address.starts_with("localhost");
+}
+
+std::string describe(const DeviceInfo& info) {
+  std::ostringstream s;
+  s << "board " << info.board << ", firmware " << info.firmwareVersion << " (" << info.halBackend
+    << " HAL), " << info.cameras << (info.cameras == 1 ? " camera " : " cameras ") << info.width
+    << "x" << info.height << " at " << info.fps << " fps, " << info.projectors << " projectors";
+  return s.str();
+}
+
+int runInfo(const DeviceOptions& opts, const CliStreams& io) {
+  auto client = DeviceClient::connect(opts.device, kConnectTimeout);
+  if (!client) {
+    io.err << "stripemux info: " << client.error() << "\n";
+    return kExitDeviceOrIo;
+  }
+  const DeviceInfo& info = client->info();
+  io.out << "device " << info.address << "\n"
+         << "  board:       " << info.board << "\n"
+         << "  firmware:    " << info.firmwareVersion << " (" << info.halBackend << " HAL)\n"
+         << "  cameras:     " << info.cameras << " x " << info.width << "x" << info.height << " at "
+         << info.fps << " fps:";
+  for (const auto& camera : info.rig.cameras) {
+    io.out << " " << camera.id;
+  }
+  io.out << "\n  projectors:  " << info.projectors << ":";
+  for (const auto& projector : info.rig.projectors) {
+    io.out << " " << projector.id;
+  }
+  io.out << "\n  depth unit:  " << info.depthUnitM << " m\n  compression:";
+  for (const auto c : {protocol::Compression::kNone, protocol::Compression::kRvl}) {
+    if ((info.compressionsMask >> static_cast<unsigned>(c) & 1U) != 0) {
+      io.out << " " << protocol::toString(c);
+    }
+  }
+  io.out << "\n";
+  if (client->requestStatistics()) {
+    const auto deadline = Clock::now() + kConnectTimeout;
+    while (Clock::now() < deadline) {
+      auto event = client->next(std::chrono::milliseconds(200));
+      if (event && std::holds_alternative<protocol::Statistics>(*event)) {
+        const auto& s = std::get<protocol::Statistics>(*event);
+        io.out << "  up:          " << static_cast<double>(s.uptimeMs) / 1000.0 << " s, "
+               << s.framesCaptured << " frames captured, " << s.framesDecoded << " decoded, "
+               << s.framesSent << " sent, " << s.framesDropped << " dropped\n";
+        break;
+      }
+    }
+  }
+  return kExitOk;
+}
+
+// Running figures of a stream.
+struct StreamTally {
+  std::map<int, int> perCamera;
+  std::uint64_t frames = 0;
+  std::uint64_t wireBytes = 0;
+  std::uint64_t rawBytes = 0;
+  std::vector<double> latencyMs;  // capture → received (same clock only)
+  std::vector<double> deviceMs;   // capture → queued at the device
+  double decodeMsTotal = 0;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) {
+    return 0;
+  }
+  std::ranges::sort(v);
+  return v[static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
+}
+
+double mean(const std::vector<double>& v) {
+  double sum = 0;
+  for (const double x : v) {
+    sum += x;
+  }
+  return v.empty() ? 0 : sum / static_cast<double>(v.size());
+}
+
+class FrameWriter {
+ public:
+  FrameWriter(const StreamOptions& opts, const DeviceInfo& info) : opts_(opts), info_(info) {}
+
+  std::expected<void, std::string> write(const ReceivedFrame& frame) {
+    const auto cameraIndex = static_cast<std::size_t>(frame.header.camera);
+    if (cameraIndex >= info_.rig.cameras.size()) {
+      return std::unexpected("range frame of camera " + std::to_string(cameraIndex) +
+                             ", but the device has " + std::to_string(info_.rig.cameras.size()));
+    }
+    const algo::Camera& camera = info_.rig.cameras[cameraIndex];
+    const auto depth =
+        *algo::ConstDepthPlane::packed(frame.depth, frame.header.width, frame.header.height);
+    const std::string stem = camera.id + "_" + std::to_string(frame.header.frame);
+    if (auto ok = sim::writePngGray16(opts_.out / (stem + ".depth.png"), depth); !ok) {
+      return ok;
+    }
+    const double unitM = frame.header.depthUnitNm * 1e-9;
+    auto points = depthToWorldPoints(camera, depth, unitM);
+    if (!opts_.noPly) {
+      if (auto ok = sim::writePlyPoints(opts_.out / (stem + ".ply"), points); !ok) {
+        return ok;
+      }
+    }
+    // The latest capture: kept for merged.ply and the previews.
+    if (frame.header.frame != latestFrame_) {
+      latestFrame_ = frame.header.frame;
+      latest_.clear();
+    }
+    latest_[cameraIndex] = {std::move(points), frame.depth, frame.header};
+    return {};
+  }
+
+  // merged.ply and <camera>.preview.png of the latest capture.
+  std::expected<std::string, std::string> finish() {
+    std::vector<sim::PlyPoint> merged;
+    for (const auto& [camera, kept] : latest_) {
+      merged.insert(merged.end(), kept.points.begin(), kept.points.end());
+      const auto depth =
+          *algo::ConstDepthPlane::packed(kept.depth, kept.header.width, kept.header.height);
+      const std::string id = info_.rig.cameras[camera].id;
+      if (auto ok = sim::writePngRgb8(opts_.out / (id + ".preview.png"), renderDepth(depth).view());
+          !ok) {
+        return std::unexpected(ok.error());
+      }
+    }
+    if (auto ok = sim::writePlyPoints(opts_.out / "merged.ply", merged); !ok) {
+      return std::unexpected(ok.error());
+    }
+    return "merged.ply (" + std::to_string(merged.size()) + " points of frame " +
+           std::to_string(latestFrame_) + ")";
+  }
+
+ private:
+  struct Kept {
+    std::vector<sim::PlyPoint> points;
+    std::vector<std::uint16_t> depth;
+    protocol::RangeFrameHeader header;
+  };
+  const StreamOptions& opts_;
+  const DeviceInfo& info_;
+  std::uint64_t latestFrame_ = ~std::uint64_t{0};
+  std::map<std::size_t, Kept> latest_;
+};
+
+int runStream(const StreamOptions& opts, const CliStreams& io) {
+  const auto compression =
+      opts.compression == "none" ? protocol::Compression::kNone : protocol::Compression::kRvl;
+  auto client = DeviceClient::connect(opts.device, kConnectTimeout);
+  if (!client) {
+    io.err << "stripemux stream: " << client.error() << "\n";
+    return kExitDeviceOrIo;
+  }
+  const DeviceInfo& info = client->info();
+  std::error_code ec;
+  fs::create_directories(opts.out, ec);
+  if (ec) {
+    io.err << "stripemux stream: cannot create " << opts.out.string() << ": " << ec.message()
+           << "\n";
+    return kExitDeviceOrIo;
+  }
+  io.out << "connected to " << info.address << ": " << describe(info) << "\n";
+  if (auto started = client->startStream(compression); !started) {
+    io.err << "stripemux stream: " << started.error() << "\n";
+    return kExitDeviceOrIo;
+  }
+
+  FrameWriter writer(opts, info);
+  StreamTally tally;
+  const bool sameClock = isLoopback(info.address);
+  const auto start = Clock::now();
+  auto lastReport = start;
+  std::optional<protocol::Statistics> deviceStats;
+  bool stopping = false;
+  const auto fail = [&](const std::string& message) {
+    io.err << "stripemux stream: " << info.address << ": " << message << "\n";
+    return kExitDeviceOrIo;
+  };
+  while (!deviceStats) {
+    const auto event = client->next(std::chrono::milliseconds(250));
+    if (!event) {
+      return fail(event.error());
+    }
+    if (const auto* frame = std::get_if<ReceivedFrame>(&*event)) {
+      if (auto ok = writer.write(*frame); !ok) {
+        return fail(ok.error());
+      }
+      ++tally.frames;
+      ++tally.perCamera[frame->header.camera];
+      tally.wireBytes += frame->wireBytes;
+      tally.rawBytes += 2 * frame->depth.size();
+      tally.decodeMsTotal += frame->header.decodeTimeUs / 1000.0;
+      tally.deviceMs.push_back(
+          static_cast<double>(frame->header.sentTimestampNs - frame->header.captureTimestampNs) /
+          1e6);
+      if (sameClock) {
+        tally.latencyMs.push_back(
+            static_cast<double>(frame->receivedNs - frame->header.captureTimestampNs) / 1e6);
+      }
+    } else if (const auto* stats = std::get_if<protocol::Statistics>(&*event)) {
+      if (stopping) {
+        deviceStats = *stats;
+      }
+    }
+    const auto now = Clock::now();
+    const double elapsedS = std::chrono::duration<double>(now - start).count();
+    const int fewest = tally.perCamera.size() < static_cast<std::size_t>(info.cameras)
+                           ? 0
+                           : std::ranges::min(tally.perCamera | std::views::values);
+    if (now - lastReport >= std::chrono::seconds(1)) {
+      lastReport = now;
+      io.out << "  " << tally.frames << " frames, " << std::round(10 * fewest / elapsedS) / 10
+             << " fps per camera, "
+             << (tally.frames == 0 ? 0 : tally.wireBytes / tally.frames / 1024) << " KiB/frame\n"
+             << std::flush;
+    }
+    if (!stopping && (fewest >= opts.frames || elapsedS > opts.timeoutS)) {
+      if (fewest < opts.frames) {
+        io.err << "stripemux stream: only " << fewest << " of " << opts.frames
+               << " frames per camera in " << opts.timeoutS << " s; stopping\n";
+      }
+      if (auto stopped = client->stopStream(); !stopped) {
+        return fail(stopped.error());
+      }
+      stopping = true;
+    }
+    if (stopping && elapsedS > opts.timeoutS + 10) {
+      return fail("no statistics after stop-stream");
+    }
+  }
+  const double elapsedS = std::chrono::duration<double>(Clock::now() - start).count();
+  const auto merged = writer.finish();
+  if (!merged) {
+    return fail(merged.error());
+  }
+
+  const double perFrame =
+      tally.frames == 0 ? 0
+                        : static_cast<double>(tally.wireBytes) / static_cast<double>(tally.frames);
+  const double ratio = tally.wireBytes == 0 ? 0
+                                            : static_cast<double>(tally.rawBytes) /
+                                                  static_cast<double>(tally.wireBytes);
+  const double fps = tally.perCamera.empty()
+                         ? 0
+                         : std::ranges::min(tally.perCamera | std::views::values) / elapsedS;
+  Json summary = {{"device", info.address},
+                  {"board", info.board},
+                  {"firmware", info.firmwareVersion},
+                  {"frames_received", tally.frames},
+                  {"frames_per_camera", Json::object()},
+                  {"seconds", elapsedS},
+                  {"fps_per_camera", fps},
+                  {"bytes_per_frame", perFrame},
+                  {"compression", opts.compression},
+                  {"compression_ratio", ratio},
+                  {"mbit_per_s_at_30fps_per_camera", perFrame * 8 * 30 / 1e6},
+                  {"device_capture_to_queued_ms",
+                   {{"mean", mean(tally.deviceMs)}, {"p95", percentile(tally.deviceMs, 0.95)}}},
+                  {"decode_ms_mean",
+                   tally.frames == 0 ? 0 : tally.decodeMsTotal / static_cast<double>(tally.frames)},
+                  {"device_counters",
+                   {{"captured", deviceStats->framesCaptured},
+                    {"decoded", deviceStats->framesDecoded},
+                    {"sent", deviceStats->framesSent},
+                    {"dropped", deviceStats->framesDropped},
+                    {"capture_errors", deviceStats->captureErrors},
+                    {"protocol_errors", deviceStats->protocolErrors}}}};
+  for (const auto& [camera, count] : tally.perCamera) {
+    summary["frames_per_camera"][info.rig.cameras[static_cast<std::size_t>(camera)].id] = count;
+  }
+  if (sameClock) {
+    summary["capture_to_host_ms"] = {{"mean", mean(tally.latencyMs)},
+                                     {"p95", percentile(tally.latencyMs, 0.95)}};
+  }
+  std::ofstream(opts.out / "summary.json") << summary.dump(2) << "\n";
+
+  io.out << "received " << tally.frames << " range frames in " << std::round(elapsedS * 10) / 10
+         << " s (" << std::round(fps * 10) / 10 << " fps per camera); the device sent "
+         << deviceStats->framesSent << ", dropped " << deviceStats->framesDropped << "\n"
+         << "  " << std::lround(perFrame / 1024) << " KiB per frame on the wire ("
+         << opts.compression << ", " << std::round(ratio * 10) / 10 << ":1), "
+         << std::round(perFrame * 8 * 30 / 1e5) / 10 << " Mbit/s at 30 fps per camera\n";
+  if (sameClock) {
+    io.out << "  latency capture -> host " << std::round(mean(tally.latencyMs) * 10) / 10
+           << " ms mean, " << std::round(percentile(tally.latencyMs, 0.95) * 10) / 10
+           << " ms p95\n";
+  }
+  io.out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
+         << (opts.noPly ? "" : " and .ply") << ", " << *merged << ", <camera>.preview.png and "
+         << "summary.json\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<DeviceOptions>();
+  auto* cmd = app.add_subcommand("info", "What a device reports: board, firmware, rig, counters");
+  cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
+      ->required();
+  cmd->callback([opts, &io, &exitCode] { exitCode = runInfo(*opts, io); });
+}
+
+void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<StreamOptions>();
+  auto* cmd = app.add_subcommand(
+      "stream", "Receive range images from a device: depth PNGs, PLY point clouds, a summary");
+  cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
+      ->required();
+  cmd->add_option("--out", opts->out, "Output directory")->required();
+  cmd->add_option("--frames", opts->frames, "Frames per camera to receive (default 10)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--compression", opts->compression, "rvl (default) or none")
+      ->check(CLI::IsMember({"rvl", "none"}));
+  cmd->add_option("--timeout", opts->timeoutS, "Give up after this many seconds (default 30)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--no-ply", opts->noPly, "Depth PNGs only, no point cloud per frame");
+  cmd->callback([opts, &io, &exitCode] { exitCode = runStream(*opts, io); });
+}
+
+}  // namespace smx::host

@@ -1,0 +1,181 @@
+#include "device_client.hpp"
+
+#include <ctime>
+
+#include "smx/protocol/rig_json.hpp"
+
+namespace smx::host {
+
+namespace {
+
+using Fail = std::unexpected<std::string>;
+using protocol::MessageType;
+
+std::int64_t monotonicNs() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
+std::string deviceError(std::span<const std::byte> payload) {
+  const auto error = protocol::decodeError(payload);
+  if (!error) {
+    return "the device reported an error (unreadable)";
+  }
+  return "the device refused: " + std::string(error->text);
+}
+
+}  // namespace
+
+DeviceClient::DeviceClient(net::TcpClient socket, std::string address)
+    : socket_(std::move(socket)),
+      parser_(std::make_unique<protocol::StreamParser>(protocol::kMaxPayloadBytes)),
+      out_(4096) {
+  info_.address = std::move(address);
+}
+
+std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string& address,
+                                                               std::chrono::milliseconds timeout) {
+  const auto parsed = net::parseDeviceAddress(address, protocol::kDefaultPort);
+  if (!parsed) {
+    return Fail("--device: " + parsed.error());
+  }
+  const std::string where = parsed->host + ":" + std::to_string(parsed->port);
+  auto socket = net::TcpClient::connect(*parsed, timeout);
+  if (!socket) {
+    return Fail(socket.error());
+  }
+  DeviceClient client(std::move(*socket), where);
+  if (auto hello =
+          client.send(protocol::encode(protocol::Hello{"stripemux " SMX_VERSION}, client.out_));
+      !hello) {
+    return Fail(hello.error());
+  }
+  auto reply = client.nextMessage(timeout);
+  if (!reply) {
+    return Fail(where + ": " + reply.error());
+  }
+  if (!*reply) {
+    return Fail(where + ": the device did not answer hello within " +
+                std::to_string(timeout.count()) + " ms (is it a stripemux device?)");
+  }
+  const auto& [type, payload] = **reply;
+  if (type == MessageType::kError) {
+    return Fail(where + ": " + deviceError(payload));
+  }
+  const auto caps =
+      type == MessageType::kCapabilities
+          ? protocol::decodeCapabilities(payload)
+          : protocol::protocolFail(protocol::ProtocolErrc::kMalformed, "expected capabilities");
+  if (!caps) {
+    return Fail(where + ": bad answer to hello: " + caps.error().message);
+  }
+  DeviceInfo& info = client.info_;
+  info.board = caps->board;
+  info.firmwareVersion = caps->firmwareVersion;
+  info.halBackend = caps->halBackend;
+  info.depthUnitM = caps->depthUnitNm * 1e-9;
+  info.cameras = caps->cameras;
+  info.projectors = caps->projectors;
+  info.width = caps->width;
+  info.height = caps->height;
+  info.fps = caps->fps;
+  info.compressionsMask = caps->compressionsMask;
+  info.rigJson = caps->rigJson;
+  auto rig = protocol::parseRig(info.rigJson);
+  if (!rig) {
+    return Fail(where + ": the device's rig is invalid: " + rig.error().message());
+  }
+  info.rig = std::move(*rig);
+  return client;
+}
+
+std::expected<void, std::string> DeviceClient::send(
+    const protocol::ProtocolResult<std::span<const std::byte>>& message) {
+  if (!message) {
+    return Fail(std::string("cannot encode a request: ") + message.error().message);
+  }
+  return socket_.sendAll(*message, std::chrono::milliseconds(5000));
+}
+
+std::expected<void, std::string> DeviceClient::startStream(protocol::Compression compression) {
+  return send(protocol::encode(protocol::StartStream{compression}, out_));
+}
+
+std::expected<void, std::string> DeviceClient::stopStream() {
+  return send(protocol::encodeEmpty(MessageType::kStopStream, out_));
+}
+
+std::expected<void, std::string> DeviceClient::requestStatistics() {
+  return send(protocol::encodeEmpty(MessageType::kGetStatistics, out_));
+}
+
+std::expected<std::optional<std::pair<MessageType, std::vector<std::byte>>>, std::string>
+DeviceClient::nextMessage(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    while (true) {
+      const auto next = parser_->next();
+      if (!next) {
+        continue;  // counted by the parser; it has skipped the bad bytes
+      }
+      if (!next->has_value()) {
+        break;
+      }
+      const auto& message = **next;
+      return std::pair{message.type,
+                       std::vector<std::byte>(message.payload.begin(), message.payload.end())};
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      return std::nullopt;
+    }
+    const auto got = socket_.receiveSome(parser_->writable(), left);
+    if (!got) {
+      return Fail(got.error());
+    }
+    parser_->commit(*got);
+  }
+}
+
+std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::milliseconds timeout) {
+  auto message = nextMessage(timeout);
+  if (!message) {
+    return Fail(message.error());
+  }
+  if (!*message) {
+    return DeviceEvent{};
+  }
+  const auto& [type, payload] = **message;
+  switch (type) {
+    case MessageType::kRangeFrame: {
+      const auto frame = protocol::decodeRangeFrame(payload);
+      if (!frame) {
+        return Fail(std::string("bad range frame: ") + frame.error().message);
+      }
+      ReceivedFrame received;
+      received.header = frame->header;
+      received.depth.resize(std::size_t{frame->header.width} * frame->header.height);
+      if (const auto ok = protocol::decodeRangeDepth(*frame, received.depth); !ok) {
+        return Fail(std::string("bad range frame: ") + ok.error().message);
+      }
+      received.wireBytes = protocol::kHeaderBytes + payload.size();
+      received.receivedNs = monotonicNs();
+      return DeviceEvent{std::move(received)};
+    }
+    case MessageType::kStatistics: {
+      const auto stats = protocol::decodeStatistics(payload);
+      if (!stats) {
+        return Fail(std::string("bad statistics: ") + stats.error().message);
+      }
+      return DeviceEvent{*stats};
+    }
+    case MessageType::kError:
+      return Fail(deviceError(payload));
+    default:
+      return DeviceEvent{};  // nothing the host waits for here
+  }
+}
+
+}  // namespace smx::host

@@ -1,0 +1,76 @@
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <expected>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "smx/algo/rig.hpp"
+#include "smx/net/tcp_client.hpp"
+#include "smx/protocol/messages.hpp"
+#include "smx/protocol/stream_parser.hpp"
+
+// The host tool's side of the protocol (docs/protocol.md): connect, hello → capabilities,
+// start/stop the stream, read range frames and statistics. Errors are messages for the user.
+namespace smx::host {
+
+struct DeviceInfo {
+  std::string address;  // host:port as connected
+  std::string board;
+  std::string firmwareVersion;
+  std::string halBackend;
+  double depthUnitM = 1e-4;
+  int cameras = 0;
+  int projectors = 0;
+  int width = 0;
+  int height = 0;
+  int fps = 0;
+  std::uint8_t compressionsMask = 0;
+  std::string rigJson;
+  algo::Rig rig;
+};
+
+struct ReceivedFrame {
+  protocol::RangeFrameHeader header;
+  std::vector<std::uint16_t> depth;  // width × height, row by row
+  std::size_t wireBytes = 0;         // the whole message
+  std::int64_t receivedNs = 0;       // host CLOCK_MONOTONIC
+};
+
+// What next() found: a range frame, the device's statistics, or nothing before the timeout.
+using DeviceEvent = std::variant<std::monostate, ReceivedFrame, protocol::Statistics>;
+
+class DeviceClient {
+ public:
+  [[nodiscard]] static std::expected<DeviceClient, std::string> connect(
+      const std::string& address, std::chrono::milliseconds timeout);
+
+  [[nodiscard]] const DeviceInfo& info() const { return info_; }
+  [[nodiscard]] std::expected<void, std::string> startStream(protocol::Compression compression);
+  [[nodiscard]] std::expected<void, std::string> stopStream();
+  [[nodiscard]] std::expected<void, std::string> requestStatistics();
+  [[nodiscard]] std::expected<DeviceEvent, std::string> next(std::chrono::milliseconds timeout);
+  // Bad messages from the device so far (skipped).
+  [[nodiscard]] std::uint64_t protocolErrors() const { return parser_->counters().errors; }
+  void close() { socket_.close(); }
+
+ private:
+  DeviceClient(net::TcpClient socket, std::string address);
+  [[nodiscard]] std::expected<void, std::string> send(
+      const protocol::ProtocolResult<std::span<const std::byte>>& message);
+  // The next whole message (copied), or nullopt on timeout.
+  [[nodiscard]] std::expected<
+      std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>>, std::string>
+  nextMessage(std::chrono::milliseconds timeout);
+
+  net::TcpClient socket_;
+  std::unique_ptr<protocol::StreamParser> parser_;
+  std::vector<std::byte> out_;
+  DeviceInfo info_;
+};
+
+}  // namespace smx::host
