@@ -31,7 +31,7 @@ constexpr std::array<std::string_view, 5> kCameraKeys = {"id", "device", "pixel_
                                                          "buffers"};
 constexpr std::array<std::string_view, 2> kTriggerKeys = {"lead_us", "lines"};
 constexpr std::array<std::string_view, 4> kLineKeys = {"role", "chip", "line", "active_low"};
-constexpr std::array<std::string_view, 2> kNetworkKeys = {"bind", "port"};
+constexpr std::array<std::string_view, 3> kNetworkKeys = {"bind", "port", "send_buffer_kib"};
 constexpr std::array<std::string_view, 3> kSimKeys = {"scene", "replay", "seed"};
 constexpr std::array<std::string_view, 2> kHals = {"sim", "linux"};
 constexpr std::array<std::string_view, 3> kPixelFormats = {"RGB24", "BGR24", "YUYV"};
@@ -189,6 +189,10 @@ void readNetwork(Reader& r, const Json& doc, hal::BoardConfig& board) {
   int port = board.network.port;
   r.integer(*network, "network", "port", 0, 65535, "TCP port; 0: any free one", port);
   board.network.port = static_cast<std::uint16_t>(port);
+  int sendBufferKib = 0;
+  r.integer(*network, "network", "send_buffer_kib", 0, 65536, "KiB; 0: the system's default",
+            sendBufferKib);
+  board.network.sendBufferBytes = sendBufferKib * 1024;
 }
 
 void readSim(Reader& r, const Json& doc, const fs::path& dir, hal::BoardConfig& board) {

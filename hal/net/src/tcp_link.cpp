@@ -59,7 +59,8 @@ std::expected<std::unique_ptr<TcpLink>, std::string> TcpLink::create(
   if (::getsockname(listener.get(), reinterpret_cast<sockaddr*>(&bound), &length) != 0) {
     return std::unexpected(systemError("cannot read the port of " + where));
   }
-  return std::unique_ptr<TcpLink>(new TcpLink(std::move(listener), ntohs(bound.sin_port)));
+  return std::unique_ptr<TcpLink>(
+      new TcpLink(std::move(listener), ntohs(bound.sin_port), network.sendBufferBytes));
 }
 
 hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
@@ -83,6 +84,9 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
   }
   const int yes = 1;
   ::setsockopt(client.get(), IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
+  if (sendBufferBytes_ > 0) {
+    ::setsockopt(client.get(), SOL_SOCKET, SO_SNDBUF, &sendBufferBytes_, sizeof sendBufferBytes_);
+  }
   client_ = std::move(client);
   return {};
 }

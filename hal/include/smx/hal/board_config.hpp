@@ -34,6 +34,10 @@ struct TriggerConfig {
 struct NetworkConfig {
   std::string bindAddress = "0.0.0.0";
   std::uint16_t port = 5555;  // 0: any free port (tests)
+  // The kernel's send buffer for the host connection (0: the system's default). Small keeps
+  // frames in the firmware's queue, where a slow host makes the oldest drop, rather than in the
+  // kernel, where they would only grow old.
+  int sendBufferBytes = 0;
 };
 
 // Only the simulated board: what its cameras see.

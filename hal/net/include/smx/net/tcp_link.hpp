@@ -32,12 +32,14 @@ class TcpLink final : public hal::Link {
   [[nodiscard]] std::uint64_t refusedClients() const { return refused_; }
 
  private:
-  TcpLink(UniqueFd listener, std::uint16_t port) : listener_(std::move(listener)), port_(port) {}
+  TcpLink(UniqueFd listener, std::uint16_t port, int sendBufferBytes)
+      : listener_(std::move(listener)), port_(port), sendBufferBytes_(sendBufferBytes) {}
   void refusePending();
 
   UniqueFd listener_;
   UniqueFd client_;
   std::uint16_t port_;
+  int sendBufferBytes_;
   std::uint64_t refused_ = 0;
 };
 

@@ -1,0 +1,365 @@
+// The firmware end to end on the simulated board over loopback (label "sim"): the capture and
+// network loops of stripemuxd, a host on a real TCP connection, faults injected into the
+// simulated cameras. Frames are replayed from renders made once, so the pipeline sees the same
+// images `stripemux decode` is given.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "cli.hpp"
+#include "device_client.hpp"
+#include "smx/board/board_json.hpp"
+#include "smx/device/device.hpp"
+#include "smx/hal/board_hal.hpp"
+#include "smx/net/tcp_client.hpp"
+#include "smx/protocol/messages.hpp"
+#include "smx/protocol/rig_json.hpp"
+#include "smx/sim/png_io.hpp"
+#include "smx/sim/sim_board.hpp"
+
+namespace smx {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const fs::path kSource = SMX_SOURCE_DIR;
+constexpr int kReplayFrames = 3;
+
+fs::path replayDir() {
+  return fs::temp_directory_path() / "smx_firmware_sim_test_frames";
+}
+
+int cli(const std::vector<std::string>& args) {
+  std::ostringstream out;
+  std::ostringstream err;
+  const int code = host::runCli(args, {out, err});
+  EXPECT_EQ(code, 0) << err.str();
+  return code;
+}
+
+// The sim board replaying `replayDir()`, on a free loopback port, with 1 or 2 cameras.
+board::Board simBoard(int cameras) {
+  auto loaded = board::loadBoard(kSource / "boards" / "sim");
+  EXPECT_TRUE(loaded.has_value());
+  board::Board board = std::move(*loaded);
+  board.config.sim.scene.clear();
+  board.config.sim.replayDir = replayDir();
+  board.config.network.port = 0;
+  board.config.network.sendBufferBytes = 64 * 1024;
+  for (auto& camera : board.config.cameras) {
+    camera.format.fps = 1000;  // as fast as the pipeline goes
+  }
+  if (cameras == 1) {
+    board.rig = protocol::loadRig(kSource / "boards" / "sim" / "rig_2proj_1cam.json").value();
+    board.config.cameras.resize(1);
+  }
+  return board;
+}
+
+// A device on the simulated board with its network loop running.
+struct RunningDevice {
+  explicit RunningDevice(int cameras) : board(simBoard(cameras)) {
+    auto made = hal::createBoardHal(board.config, board.rig);
+    EXPECT_TRUE(made.has_value()) << made.error();
+    boardHal = std::move(*made);
+    auto dev = device::Device::create(board, boardHal->hal(), {});
+    EXPECT_TRUE(dev.has_value()) << dev.error();
+    device = std::move(*dev);
+    network = std::jthread([this] { device->runNetwork(stopNetwork); });
+  }
+  ~RunningDevice() {
+    stopCapture = true;
+    if (capture.joinable()) {
+      capture.join();
+    }
+    stopNetwork = true;
+  }
+  RunningDevice(const RunningDevice&) = delete;
+  RunningDevice& operator=(const RunningDevice&) = delete;
+
+  void startCapture() {
+    capture = std::jthread([this] { device->runCapture(stopCapture); });
+  }
+  [[nodiscard]] std::string address() const {
+    return "127.0.0.1:" + std::to_string(boardHal->hal().link.port());
+  }
+  [[nodiscard]] sim::SimBoardControl& control() const { return *sim::simBoardControl(*boardHal); }
+
+  board::Board board;
+  std::unique_ptr<hal::BoardHal> boardHal;
+  std::unique_ptr<device::Device> device;
+  std::atomic<bool> stopNetwork = false;
+  std::atomic<bool> stopCapture = false;
+  std::jthread network;
+  std::jthread capture;
+};
+
+// A host that says hello, starts the stream and then only reads into one fixed buffer (or, while
+// `paused`, not at all): it allocates nothing after connect.
+class RawHost {
+ public:
+  explicit RawHost(const std::string& address) {
+    auto parsed = net::parseDeviceAddress(address, 0).value();
+    auto socket = net::TcpClient::connect(parsed, 2000ms);
+    EXPECT_TRUE(socket.has_value());
+    socket_.emplace(std::move(*socket));
+  }
+  void send(const protocol::ProtocolResult<std::span<const std::byte>>& message) {
+    ASSERT_TRUE(message.has_value());
+    ASSERT_TRUE(socket_->sendAll(*message, 2000ms).has_value());
+  }
+  void helloAndStart() {
+    std::array<std::byte, 256> out{};
+    send(protocol::encode(protocol::Hello{"raw host"}, out));
+    send(protocol::encode(protocol::StartStream{protocol::Compression::kRvl}, out));
+  }
+  void startDraining() {
+    reader_ = std::jthread([this] {
+      while (!stop_) {
+        if (paused_) {
+          std::this_thread::sleep_for(5ms);
+          continue;
+        }
+        const auto got = socket_->receiveSome(buffer_, 50ms);
+        if (!got) {
+          return;
+        }
+        bytes_ += *got;
+      }
+    });
+  }
+  void pause(bool paused) { paused_ = paused; }
+  [[nodiscard]] std::uint64_t bytes() const { return bytes_; }
+  ~RawHost() { stop_ = true; }
+  RawHost(const RawHost&) = delete;
+  RawHost& operator=(const RawHost&) = delete;
+
+ private:
+  std::optional<net::TcpClient> socket_;
+  std::array<std::byte, 1 << 16> buffer_{};
+  std::atomic<bool> stop_ = false;
+  std::atomic<bool> paused_ = false;
+  std::atomic<std::uint64_t> bytes_ = 0;
+  std::jthread reader_;
+};
+
+class FirmwareSim : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (fs::exists(replayDir() / ("cam1_" + std::to_string(kReplayFrames - 1) + ".png"))) {
+      return;
+    }
+    cli({"sim", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--scene",
+         "turntable", "--frames", std::to_string(kReplayFrames), "--no-truth", "--out",
+         replayDir().string()});
+  }
+};
+
+TEST_F(FirmwareSim, HundredFramesWhileStreamingAllocateNothing) {
+  RunningDevice running(1);
+  RawHost host(running.address());
+  host.helloAndStart();
+  host.startDraining();
+  // Warm up: the host is accepted and streaming, every buffer has been touched.
+  while (!running.device->streaming()) {
+    std::this_thread::sleep_for(1ms);
+  }
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value());
+  }
+  const auto& counters = running.device->counters();
+  const std::uint64_t decodedBefore = counters.framesDecoded;
+  const std::uint64_t queuedBefore = counters.framesQueued;
+
+  const test::AllocationCounter allocations;
+  int failed = 0;
+  for (int i = 0; i < 100; ++i) {
+    failed += running.device->captureOnce().has_value() ? 0 : 1;
+  }
+  const std::uint64_t heapCalls = allocations.allocations();
+
+  EXPECT_EQ(heapCalls, 0U) << "the capture and network loops allocated during 100 frames";
+  EXPECT_EQ(failed, 0);
+  EXPECT_EQ(counters.framesDecoded - decodedBefore, 100U);
+  EXPECT_EQ(counters.framesQueued - queuedBefore, 100U);
+  EXPECT_GT(counters.framesSent, 50U);  // and they went out to the host meanwhile
+  EXPECT_GT(host.bytes(), 50U * 50'000U);
+}
+
+TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
+  RunningDevice running(2);
+  running.startCapture();
+  auto client = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(client.has_value()) << client.error();
+  EXPECT_EQ(client->info().board, "sim");
+  EXPECT_EQ(client->info().cameras, 2);
+  ASSERT_TRUE(client->startStream(protocol::Compression::kRvl).has_value());
+
+  std::vector<host::ReceivedFrame> frames;
+  std::optional<protocol::Statistics> stats;
+  bool stopped = false;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (!stats && std::chrono::steady_clock::now() < deadline) {
+    auto event = client->next(200ms);
+    ASSERT_TRUE(event.has_value()) << event.error();
+    if (auto* frame = std::get_if<host::ReceivedFrame>(&*event)) {
+      frames.push_back(std::move(*frame));
+    } else if (auto* s = std::get_if<protocol::Statistics>(&*event); s != nullptr && stopped) {
+      stats = *s;
+    }
+    if (!stopped && frames.size() >= 8) {
+      ASSERT_TRUE(client->stopStream().has_value());
+      stopped = true;
+    }
+  }
+  ASSERT_TRUE(stats.has_value()) << "no statistics after stop-stream";
+  EXPECT_EQ(stats->framesSent, frames.size()) << "frames sent by the device != received";
+  EXPECT_EQ(stats->protocolErrors, 0U);
+  EXPECT_EQ(client->protocolErrors(), 0U);
+
+  // `stripemux decode` on each replayed image, once.
+  const fs::path offline = fs::temp_directory_path() / "smx_firmware_sim_test_decode";
+  for (int i = 0; i < kReplayFrames; ++i) {
+    const std::string n = std::to_string(i);
+    cli({"decode", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--image",
+         "cam0=" + (replayDir() / ("cam0_" + n + ".png")).string(), "--image",
+         "cam1=" + (replayDir() / ("cam1_" + n + ".png")).string(), "--out",
+         (offline / n).string()});
+  }
+  for (const auto& frame : frames) {
+    // The simulated camera replays image k for its k-th frame; no capture failed here, so the
+    // device's frame number is k.
+    const std::string id = frame.header.camera == 0 ? "cam0" : "cam1";
+    const auto expected = sim::readPngGray16(
+        offline / std::to_string(frame.header.frame % kReplayFrames) / (id + ".depth.png"));
+    ASSERT_TRUE(expected.has_value());
+    EXPECT_EQ(frame.depth, expected->pixels)
+        << id << " frame " << frame.header.frame << " differs from stripemux decode";
+  }
+}
+
+TEST_F(FirmwareSim, AHostCanLeaveAndAnotherConnect) {
+  RunningDevice running(1);
+  running.startCapture();
+  for (int round = 0; round < 2; ++round) {
+    auto client = host::DeviceClient::connect(running.address(), 3000ms);
+    ASSERT_TRUE(client.has_value()) << client.error();
+    ASSERT_TRUE(client->startStream(protocol::Compression::kRvl).has_value());
+    int received = 0;
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (received < 2 && std::chrono::steady_clock::now() < deadline) {
+      auto event = client->next(200ms);
+      ASSERT_TRUE(event.has_value()) << event.error();
+      received += std::holds_alternative<host::ReceivedFrame>(*event) ? 1 : 0;
+    }
+    EXPECT_EQ(received, 2) << "round " << round;
+    client->close();  // leaves mid-stream, without stop
+  }
+  EXPECT_EQ(running.device->counters().connections, 2U);
+}
+
+TEST_F(FirmwareSim, ASlowHostMakesTheDeviceDropFramesButNotStopCapturing) {
+  RunningDevice running(1);
+  RawHost host(running.address());
+  host.helloAndStart();
+  host.pause(true);
+  host.startDraining();
+  while (!running.device->streaming()) {
+    std::this_thread::sleep_for(1ms);
+  }
+  // The host reads nothing while the device captures 25 frames: each capture still completes.
+  constexpr int kCaptures = 25;
+  for (int i = 0; i < kCaptures; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value()) << "capture " << i;
+  }
+  const auto& counters = running.device->counters();
+  EXPECT_EQ(counters.framesDecoded, std::uint64_t{kCaptures});
+  EXPECT_EQ(counters.captureErrors, 0U);
+  // What is not dropped fits in the queue (4 slots) and the socket buffers (a few frames).
+  EXPECT_GE(running.device->framesDropped(), std::uint64_t{kCaptures - 12});
+  // Once the host reads again, frames flow.
+  const std::uint64_t sentBefore = counters.framesSent;
+  host.pause(false);
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value());
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (counters.framesSent <= sentBefore && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_GT(counters.framesSent, sentBefore);
+}
+
+TEST_F(FirmwareSim, TriggerLinesAreActiveDuringEveryExposure) {
+  RunningDevice running(2);
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value());
+  }
+  const auto edges = running.control().triggerEdges();
+  ASSERT_EQ(edges.size(), 6U);  // on and off per capture
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    EXPECT_EQ(edges[i].activeMask, i % 2 == 0 ? 0b11U : 0U) << "edge " << i;
+  }
+  EXPECT_EQ(running.control().lastExposureMask(0), 0b11U);
+  EXPECT_EQ(running.control().lastExposureMask(1), 0b11U);
+}
+
+TEST_F(FirmwareSim, CameraFaultsAreCountedAndCaptureRecovers) {
+  RunningDevice running(1);
+  running.control().injectTimeouts(0, 2);
+  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kTimeout);
+  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kTimeout);
+  EXPECT_TRUE(running.device->captureOnce().has_value());
+
+  running.control().disconnect(0);
+  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kDisconnected);
+  EXPECT_FALSE(running.boardHal->hal().cameras[0]->recover().has_value());
+  running.control().reconnect(0);
+  EXPECT_TRUE(running.boardHal->hal().cameras[0]->recover().has_value());
+  EXPECT_TRUE(running.device->captureOnce().has_value());
+  EXPECT_EQ(running.device->counters().captureErrors, 3U);
+  EXPECT_EQ(running.device->counters().framesDecoded, 2U);
+}
+
+TEST_F(FirmwareSim, GarbageFromTheHostIsCountedAndTheConnectionStaysUsable) {
+  RunningDevice running(1);
+  auto parsed = net::parseDeviceAddress(running.address(), 0).value();
+  auto socket = net::TcpClient::connect(parsed, 2000ms);
+  ASSERT_TRUE(socket.has_value());
+  std::array<std::byte, 512> out{};
+  // Garbage, a message of protocol version 9, then a good hello.
+  const std::array<std::byte, 5> garbage{std::byte{'x'}, std::byte{1}, std::byte{'S'}, std::byte{2},
+                                         std::byte{3}};
+  ASSERT_TRUE(socket->sendAll(garbage, 1000ms).has_value());
+  auto hello = protocol::encode(protocol::Hello{"v9"}, out).value();
+  std::vector<std::byte> v9(hello.begin(), hello.end());
+  v9[4] = std::byte{9};
+  ASSERT_TRUE(socket->sendAll(v9, 1000ms).has_value());
+  ASSERT_TRUE(socket->sendAll(protocol::encode(protocol::Hello{"ok"}, out).value(), 1000ms));
+
+  protocol::StreamParser parser(1 << 20);
+  std::vector<protocol::MessageType> replies;
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (replies.size() < 2 && std::chrono::steady_clock::now() < deadline) {
+    const auto got = socket->receiveSome(parser.writable(), 100ms);
+    ASSERT_TRUE(got.has_value()) << got.error();
+    parser.commit(*got);
+    for (auto next = parser.next(); next && next->has_value(); next = parser.next()) {
+      replies.push_back((*next)->type);
+    }
+  }
+  ASSERT_EQ(replies.size(), 2U);
+  EXPECT_EQ(replies[0], protocol::MessageType::kError);  // "this device speaks version 1"
+  EXPECT_EQ(replies[1], protocol::MessageType::kCapabilities);
+  EXPECT_GE(running.device->counters().protocolErrors, 2U);  // the garbage and the v9 message
+}
+
+}  // namespace
+}  // namespace smx
