@@ -31,21 +31,8 @@ hal::HalResult<void> Device::captureOnce() {
   counters_.framesCaptured += acquired;
 
   if (status) {
-    for (std::size_t i = 0; i < acquired; ++i) {
-      const std::int64_t start = hal_.clock.nowNs();
-      auto& pipeline = *cameras_[i].pipeline;
-      if (!pipeline.run(frames_[i].image)) {
-        ++counters_.captureErrors;
-        continue;
-      }
-      const auto decodeUs = static_cast<std::uint32_t>((hal_.clock.nowNs() - start) / 1000);
-      counters_.decodeTimeUsLast = decodeUs;
-      counters_.decodeTimeUsTotal += decodeUs;
-      ++counters_.framesDecoded;
-      if (streaming_) {
-        queueRangeFrame(static_cast<int>(i), frames_[i], decodeUs);
-      }
-    }
+    auto job = [this](int camera) { decodeCamera(camera); };
+    workers_->run(static_cast<int>(acquired), job);
   } else {
     ++counters_.captureErrors;
   }
@@ -56,6 +43,22 @@ hal::HalResult<void> Device::captureOnce() {
   return status;
 }
 
+void Device::decodeCamera(int camera) {
+  const auto i = static_cast<std::size_t>(camera);
+  const std::int64_t start = hal_.clock.nowNs();
+  if (!cameras_[i].pipeline->run(frames_[i].image)) {
+    ++counters_.captureErrors;
+    return;
+  }
+  const auto decodeUs = static_cast<std::uint32_t>((hal_.clock.nowNs() - start) / 1000);
+  counters_.decodeTimeUsLast = decodeUs;
+  counters_.decodeTimeUsTotal += decodeUs;
+  ++counters_.framesDecoded;
+  if (streaming_) {
+    queueRangeFrame(camera, frames_[i], decodeUs);
+  }
+}
+
 void Device::queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs) {
   const protocol::RangeFrameHeader header{.camera = static_cast<std::uint8_t>(camera),
                                           .compression = compression_,
@@ -64,15 +67,15 @@ void Device::queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uin
                                           .sentTimestampNs = hal_.clock.nowNs(),
                                           .depthUnitNm = depthUnitNm_,
                                           .decodeTimeUs = decodeUs};
-  const std::span<std::byte> slot = queue_.beginWrite();
+  const SendQueue::WriteSlot slot = queue_.beginWrite();
   const auto message = protocol::encodeRangeFrame(
-      header, cameras_[static_cast<std::size_t>(camera)].pipeline->merged(), slot);
+      header, cameras_[static_cast<std::size_t>(camera)].pipeline->merged(), slot.bytes);
   if (!message) {
-    queue_.abandon();
+    queue_.abandon(slot);
     ++counters_.captureErrors;
     return;
   }
-  queue_.commit(message->size());
+  queue_.commit(slot, message->size());
   ++counters_.framesQueued;
 }
 

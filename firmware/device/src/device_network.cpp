@@ -137,7 +137,12 @@ void Device::pumpSend() {
 void Device::serviceNetwork(std::int64_t timeoutNs) {
   hal::Link& link = hal_.link;
   if (!link.connected()) {
+    if (hadClient_) {
+      dropConnection();  // the link noticed first that the host left
+      hadClient_ = false;
+    }
     if (link.acceptClient(timeoutNs)) {
+      hadClient_ = true;
       parser_.reset();
       helloSeen_ = false;
       ++counters_.connections;

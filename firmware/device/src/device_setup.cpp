@@ -18,8 +18,10 @@ Device::Device(const board::Board& board, hal::Hal hal, const DeviceOptions& opt
       allProjectorsMask_(static_cast<std::uint32_t>((1U << board.rig.projectors.size()) - 1U)),
       leadNs_(board.config.trigger.leadNs),
       startNs_(hal.clock.nowNs()),
-      queue_(options.queueSlots, protocol::rangeFrameBound(board.rig.cameras.front().width,
-                                                           board.rig.cameras.front().height)),
+      // Each camera's decoder may hold a slot while writing, besides the queued frames.
+      queue_(options.queueSlots + board.rig.cameras.size() + 1,
+             protocol::rangeFrameBound(board.rig.cameras.front().width,
+                                       board.rig.cameras.front().height)),
       parser_(kControlBytes) {}
 
 Device::~Device() = default;
@@ -42,6 +44,9 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const board::
   pipelineOptions.depthUnitM = board.config.depthUnitM;
   device->cameras_.resize(rig.cameras.size());
   device->frames_.resize(rig.cameras.size());
+  const int threads =
+      options.decodeThreads > 0 ? options.decodeThreads : static_cast<int>(rig.cameras.size());
+  device->workers_ = std::make_unique<WorkerPool>(threads - 1);
   for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
     const std::string& id = rig.cameras[i].id;
     const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(i), pipelineOptions);

@@ -22,38 +22,36 @@ SendQueue::Slot* SendQueue::oldestQueued() {
   return oldest;
 }
 
-std::span<std::byte> SendQueue::beginWrite() {
+SendQueue::WriteSlot SendQueue::beginWrite() {
   const std::lock_guard lock(mutex_);
-  assert(writing_ == nullptr);
+  Slot* writing = nullptr;
   for (Slot& slot : slots_) {
     if (slot.state == State::kFree) {
-      writing_ = &slot;
+      writing = &slot;
       break;
     }
   }
-  if (writing_ == nullptr) {
-    writing_ = oldestQueued();  // exists: at most one slot is being sent
+  if (writing == nullptr) {
+    writing = oldestQueued();  // exists while slots >= producers + 2
+    assert(writing != nullptr);
     ++dropped_;
   }
-  writing_->state = State::kWriting;
-  return writing_->bytes;
+  writing->state = State::kWriting;
+  return {writing->bytes, static_cast<std::size_t>(writing - slots_.data())};
 }
 
-void SendQueue::commit(std::size_t bytes) {
+void SendQueue::commit(const WriteSlot& slot, std::size_t bytes) {
   const std::lock_guard lock(mutex_);
-  assert(writing_ != nullptr && bytes <= slotBytes_);
-  writing_->size = bytes;
-  writing_->order = nextOrder_++;
-  writing_->state = State::kQueued;
-  writing_ = nullptr;
+  Slot& written = slots_[slot.index];
+  assert(written.state == State::kWriting && bytes <= slotBytes_);
+  written.size = bytes;
+  written.order = nextOrder_++;
+  written.state = State::kQueued;
 }
 
-void SendQueue::abandon() {
+void SendQueue::abandon(const WriteSlot& slot) {
   const std::lock_guard lock(mutex_);
-  if (writing_ != nullptr) {
-    writing_->state = State::kFree;
-    writing_ = nullptr;
-  }
+  slots_[slot.index].state = State::kFree;
 }
 
 std::span<const std::byte> SendQueue::beginSend() {

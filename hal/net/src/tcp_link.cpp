@@ -152,7 +152,13 @@ hal::HalResult<void> TcpLink::waitForIo(bool wantWrite, std::int64_t timeoutNs) 
     return halFail(HalErrc::kIo, "poll failed", errno);
   }
   if (client_.valid() && (fds[0].revents & POLLIN) != 0) {
-    refusePending();
+    // A host that reconnects at once may find its old connection not yet noticed as gone.
+    pollfd old{.fd = client_.get(), .events = POLLRDHUP, .revents = 0};
+    if (detail::pollRetry(&old, 1, 0) > 0 && (old.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0) {
+      client_.reset();  // the new host is accepted by the next acceptClient()
+    } else {
+      refusePending();
+    }
   }
   return {};
 }

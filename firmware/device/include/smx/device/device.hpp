@@ -11,6 +11,7 @@
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/board/board_json.hpp"
 #include "smx/device/send_queue.hpp"
+#include "smx/device/worker_pool.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/stream_parser.hpp"
@@ -23,7 +24,8 @@ namespace smx::device {
 
 struct DeviceOptions {
   std::string firmwareVersion = "0.0.0";
-  std::size_t queueSlots = 4;  // range frames waiting for the host, per device
+  std::size_t queueSlots = 4;  // range frames waiting for the host (all cameras)
+  int decodeThreads = 0;       // cameras decoded in parallel (0: one thread per camera)
   std::int64_t acquireTimeoutNs = 2'000'000'000;
   algo::PipelineOptions pipeline;  // depthUnitM is taken from the board
 };
@@ -74,6 +76,7 @@ class Device {
   };
 
   Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options);
+  void decodeCamera(int camera);
   void queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs);
   void onMessage(const protocol::Message& message);
   void sendControl(std::span<const std::byte> message);
@@ -88,6 +91,7 @@ class Device {
   std::int64_t startNs_;
   std::vector<CameraSlot> cameras_;
   std::vector<hal::CameraFrame> frames_;  // this capture's borrowed frames, per camera
+  std::unique_ptr<WorkerPool> workers_;
   std::uint64_t captureNumber_ = 0;
   DeviceCounters counters_;
   SendQueue queue_;
@@ -103,6 +107,7 @@ class Device {
   bool sendingFrame_ = false;
   std::size_t sent_ = 0;
   bool helloSeen_ = false;
+  bool hadClient_ = false;
 };
 
 }  // namespace smx::device
