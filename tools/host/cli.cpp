@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "device_client.hpp"
 
 namespace smx::host {
 
@@ -31,6 +32,17 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   }
   if (app.get_subcommands().empty()) {
     io.out << app.help();
+    // Like a depth camera's tools: with no command, also say which device answers here.
+    constexpr auto kProbe = "127.0.0.1";
+    const auto device = DeviceClient::connect(kProbe, std::chrono::milliseconds(300));
+    io.out << "\nDevices: ";
+    if (device) {
+      io.out << device->info().address << " (board " << device->info().board << ", firmware "
+             << device->info().firmwareVersion << ")\n";
+    } else {
+      io.out << "none answered on " << kProbe << ":5555 (start one with stripemuxd --board "
+             << "boards/sim; other hosts: stripemux info --device HOST)\n";
+    }
   }
   return exitCode;
 }
