@@ -14,7 +14,12 @@ set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE BOTH)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE BOTH)
 
-set(CMAKE_CROSSCOMPILING_EMULATOR /usr/bin/qemu-aarch64-static;-L;/usr/aarch64-linux-gnu)
+# The binaries run against Debian's multiarch arm64 runtime (libc6:arm64, libstdc++6:arm64, which
+# tools/install-deps installs with libgpiod-dev:arm64), loader included. With the cross
+# toolchain's own prefix (-L /usr/aarch64-linux-gnu) its loader would still find the multiarch
+# libc in /lib/aarch64-linux-gnu once that is installed, and a loader and libc of two builds
+# deadlock in thread start-up.
+set(CMAKE_CROSSCOMPILING_EMULATOR /usr/bin/qemu-aarch64-static;-L;/)
 
 # Used by the integer-only check of the per-frame objects (tests/static).
 set(SMX_TARGET_OBJDUMP aarch64-linux-gnu-objdump)
