@@ -69,7 +69,7 @@ TEST(BoardJson, ErrorsNameTheField) {
   expectError(simBoardWith(R"(,
       {"role": "proj1", "chip": "sim", "line": 1})",
                            ""),
-              "triggers.lines", "has 1 lines but the rig has 2 projectors");
+              "triggers.lines", "has 1 entries but the rig has 2 projectors");
   expectError(simBoardWith(R"("bind": "127.0.0.1")", R"("bind": "localhost")"), "network.bind",
               "is not an IPv4 address");
   expectError(simBoardWith(R"("rig": "rig_2proj_2cam.json")", R"("rig": "missing.json")"), "rig",

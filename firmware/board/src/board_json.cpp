@@ -61,19 +61,37 @@ class Reader : public config::FieldReader {
     return value;
   }
 
-  // A required array of objects of `allowed` keys.
-  const Json* objects(const Json& obj, const std::string& path, std::string_view key,
-                      std::string_view what) {
+  // A required array of `count` entries, one per rig device (`devices`: "cameras").
+  const Json* perDevice(const Json& obj, const std::string& path, std::string_view key,
+                        std::size_t count, std::string_view devices) {
     const Json* v = find(obj, key);
+    const std::string at = member(path, key);
     if (!ok()) {
       return nullptr;
     }
     if (v == nullptr || !v->is_array()) {
-      fail(member(path, key), "must be an array of " + std::string(what) +
-                                  (v == nullptr ? ", but is missing" : ", got " + describe(*v)));
+      fail(at, "must be an array, one entry per " + std::string(devices) + " of the rig" +
+                   (v == nullptr ? ", but is missing" : ", got " + describe(*v)));
+      return nullptr;
+    }
+    if (v->size() != count) {
+      fail(at, "has " + std::to_string(v->size()) + " entries but the rig has " +
+                   std::to_string(count) + " " + std::string(devices));
       return nullptr;
     }
     return v;
+  }
+
+  // The required `key` naming the rig's device `index` (`expected`), listed in the rig's order.
+  std::string rigId(const Json& obj, const std::string& path, std::string_view key,
+                    const std::string& expected, std::size_t index, std::string_view device) {
+    auto id = text(obj, path, key, "the rig's " + std::string(device) + " id").value_or("");
+    if (ok() && id != expected) {
+      fail(member(path, key), jsonQuote(id) + " is not the rig's " + std::string(device) + " " +
+                                  std::to_string(index) + " (" + jsonQuote(expected) +
+                                  "); list them in the rig's order");
+    }
+    return id;
   }
 };
 
@@ -85,13 +103,8 @@ hal::PixelFormat pixelFormat(std::string_view name) {
 }
 
 void readCameras(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardConfig& board) {
-  const Json* cameras = r.objects(doc, "", "cameras", "cameras, one per camera of the rig");
+  const Json* cameras = r.perDevice(doc, "", "cameras", rig.cameras.size(), "cameras");
   if (cameras == nullptr) {
-    return;
-  }
-  if (cameras->size() != rig.cameras.size()) {
-    r.fail("cameras", "has " + std::to_string(cameras->size()) + " entries but the rig has " +
-                          std::to_string(rig.cameras.size()) + " cameras");
     return;
   }
   for (std::size_t i = 0; i < cameras->size() && r.ok(); ++i) {
@@ -101,12 +114,7 @@ void readCameras(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCon
       return;
     }
     hal::CameraConfig camera;
-    camera.id = r.text(v, at, "id", "the rig's camera id").value_or("");
-    if (r.ok() && camera.id != rig.cameras[i].id) {
-      r.fail(member(at, "id"), jsonQuote(camera.id) + " is not the rig's camera " +
-                                   std::to_string(i) + " (" + jsonQuote(rig.cameras[i].id) +
-                                   "); list the cameras in the rig's order");
-    }
+    camera.id = r.rigId(v, at, "id", rig.cameras[i].id, i, "camera");
     camera.device = r.text(v, at, "device", "e.g. \"/dev/video0\" or \"sim\"").value_or("");
     camera.format.pixelFormat =
         pixelFormat(r.word(v, at, "pixel_format", kPixelFormats).value_or(""));
@@ -133,13 +141,9 @@ void readTriggers(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCo
   int leadUs = 0;
   r.integer(*triggers, "triggers", "lead_us", 0, 100'000, "microseconds", leadUs);
   board.trigger.leadNs = std::int64_t{leadUs} * 1000;
-  const Json* lines = r.objects(*triggers, "triggers", "lines", "trigger lines");
+  const Json* lines =
+      r.perDevice(*triggers, "triggers", "lines", rig.projectors.size(), "projectors");
   if (lines == nullptr) {
-    return;
-  }
-  if (lines->size() != rig.projectors.size()) {
-    r.fail("triggers.lines", "has " + std::to_string(lines->size()) + " lines but the rig has " +
-                                 std::to_string(rig.projectors.size()) + " projectors");
     return;
   }
   for (std::size_t i = 0; i < lines->size() && r.ok(); ++i) {
@@ -149,12 +153,7 @@ void readTriggers(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCo
       return;
     }
     hal::TriggerLineConfig line;
-    line.role = r.text(v, at, "role", "the rig's projector id").value_or("");
-    if (r.ok() && line.role != rig.projectors[i].id) {
-      r.fail(member(at, "role"), jsonQuote(line.role) + " is not the rig's projector " +
-                                     std::to_string(i) + " (" + jsonQuote(rig.projectors[i].id) +
-                                     "); list the lines in the rig's projector order");
-    }
+    line.role = r.rigId(v, at, "role", rig.projectors[i].id, i, "projector");
     line.chip = r.text(v, at, "chip", "the GPIO chip, e.g. \"gpiochip0\"").value_or("");
     int offset = -1;
     r.integer(v, at, "line", 0, 511, "the line offset on the chip", offset);
