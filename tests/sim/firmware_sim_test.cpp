@@ -209,10 +209,10 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
   while (!stats && std::chrono::steady_clock::now() < deadline) {
     auto event = client->next(200ms);
     ASSERT_TRUE(event.has_value()) << event.error();
-    if (auto* frame = std::get_if<host::ReceivedFrame>(&*event)) {
-      frames.push_back(std::move(*frame));
-    } else if (auto* s = std::get_if<protocol::Statistics>(&*event); s != nullptr && stopped) {
-      stats = *s;
+    if (event->kind == host::DeviceEvent::Kind::kFrame) {
+      frames.push_back(std::move(event->frame));
+    } else if (event->kind == host::DeviceEvent::Kind::kStatistics && stopped) {
+      stats = event->statistics;
     }
     if (!stopped && frames.size() >= 8) {
       ASSERT_TRUE(client->stopStream().has_value());
@@ -257,7 +257,7 @@ TEST_F(FirmwareSim, AHostCanLeaveAndAnotherConnect) {
     while (received < 2 && std::chrono::steady_clock::now() < deadline) {
       auto event = client->next(200ms);
       ASSERT_TRUE(event.has_value()) << event.error();
-      received += std::holds_alternative<host::ReceivedFrame>(*event) ? 1 : 0;
+      received += event->kind == host::DeviceEvent::Kind::kFrame ? 1 : 0;
     }
     EXPECT_EQ(received, 2) << "round " << round;
     client->close();  // leaves mid-stream, without stop

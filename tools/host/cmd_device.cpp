@@ -81,8 +81,8 @@ int runInfo(const DeviceOptions& opts, const CliStreams& io) {
     const auto deadline = Clock::now() + kConnectTimeout;
     while (Clock::now() < deadline) {
       auto event = client->next(std::chrono::milliseconds(200));
-      if (event && std::holds_alternative<protocol::Statistics>(*event)) {
-        const auto& s = std::get<protocol::Statistics>(*event);
+      if (event && event->kind == DeviceEvent::Kind::kStatistics) {
+        const auto& s = event->statistics;
         io.out << "  up:          " << static_cast<double>(s.uptimeMs) / 1000.0 << " s, "
                << s.framesCaptured << " frames captured, " << s.framesDecoded << " decoded, "
                << s.framesSent << " sent, " << s.framesDropped << " dropped\n";
@@ -223,26 +223,25 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
     if (!event) {
       return fail(event.error());
     }
-    if (const auto* frame = std::get_if<ReceivedFrame>(&*event)) {
-      if (auto ok = writer.write(*frame); !ok) {
+    if (event->kind == DeviceEvent::Kind::kFrame) {
+      const ReceivedFrame& frame = event->frame;
+      if (auto ok = writer.write(frame); !ok) {
         return fail(ok.error());
       }
       ++tally.frames;
-      ++tally.perCamera[frame->header.camera];
-      tally.wireBytes += frame->wireBytes;
-      tally.rawBytes += 2 * frame->depth.size();
-      tally.decodeMsTotal += frame->header.decodeTimeUs / 1000.0;
+      ++tally.perCamera[frame.header.camera];
+      tally.wireBytes += frame.wireBytes;
+      tally.rawBytes += 2 * frame.depth.size();
+      tally.decodeMsTotal += frame.header.decodeTimeUs / 1000.0;
       tally.deviceMs.push_back(
-          static_cast<double>(frame->header.sentTimestampNs - frame->header.captureTimestampNs) /
+          static_cast<double>(frame.header.sentTimestampNs - frame.header.captureTimestampNs) /
           1e6);
       if (sameClock) {
         tally.latencyMs.push_back(
-            static_cast<double>(frame->receivedNs - frame->header.captureTimestampNs) / 1e6);
+            static_cast<double>(frame.receivedNs - frame.header.captureTimestampNs) / 1e6);
       }
-    } else if (const auto* stats = std::get_if<protocol::Statistics>(&*event)) {
-      if (stopping) {
-        deviceStats = *stats;
-      }
+    } else if (event->kind == DeviceEvent::Kind::kStatistics && stopping) {
+      deviceStats = event->statistics;
     }
     const auto now = Clock::now();
     const double elapsedS = std::chrono::duration<double>(now - start).count();

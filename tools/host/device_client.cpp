@@ -11,6 +11,10 @@ namespace {
 using Fail = std::unexpected<std::string>;
 using protocol::MessageType;
 
+// About five range frames: enough to ride out a slow file write, small enough that a host that
+// keeps falling behind sees fresh frames (the device drops the oldest) rather than old ones.
+constexpr int kReceiveBufferBytes = 1 << 20;
+
 std::int64_t monotonicNs() {
   timespec now{};
   ::clock_gettime(CLOCK_MONOTONIC, &now);
@@ -41,7 +45,7 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
     return Fail("--device: " + parsed.error());
   }
   const std::string where = parsed->host + ":" + std::to_string(parsed->port);
-  auto socket = net::TcpClient::connect(*parsed, timeout);
+  auto socket = net::TcpClient::connect(*parsed, timeout, kReceiveBufferBytes);
   if (!socket) {
     return Fail(socket.error());
   }
@@ -162,14 +166,20 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
       }
       received.wireBytes = protocol::kHeaderBytes + payload.size();
       received.receivedNs = monotonicNs();
-      return DeviceEvent{std::move(received)};
+      DeviceEvent event;
+      event.kind = DeviceEvent::Kind::kFrame;
+      event.frame = std::move(received);
+      return event;
     }
     case MessageType::kStatistics: {
       const auto stats = protocol::decodeStatistics(payload);
       if (!stats) {
         return Fail(std::string("bad statistics: ") + stats.error().message);
       }
-      return DeviceEvent{*stats};
+      DeviceEvent event;
+      event.kind = DeviceEvent::Kind::kStatistics;
+      event.statistics = *stats;
+      return event;
     }
     case MessageType::kError:
       return Fail(deviceError(payload));

@@ -6,7 +6,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "smx/algo/rig.hpp"
@@ -42,7 +41,12 @@ struct ReceivedFrame {
 };
 
 // What next() found: a range frame, the device's statistics, or nothing before the timeout.
-using DeviceEvent = std::variant<std::monostate, ReceivedFrame, protocol::Statistics>;
+struct DeviceEvent {
+  enum class Kind : std::uint8_t { kNothing, kFrame, kStatistics };
+  Kind kind = Kind::kNothing;
+  ReceivedFrame frame;              // kFrame
+  protocol::Statistics statistics;  // kStatistics
+};
 
 class DeviceClient {
  public:

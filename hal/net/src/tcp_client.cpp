@@ -48,7 +48,8 @@ std::expected<DeviceAddress, std::string> parseDeviceAddress(const std::string& 
 }
 
 std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& address,
-                                                         std::chrono::milliseconds timeout) {
+                                                         std::chrono::milliseconds timeout,
+                                                         int receiveBufferBytes) {
   const std::string where = address.host + ":" + std::to_string(address.port);
   addrinfo hints{};
   hints.ai_family = AF_INET;
@@ -65,6 +66,9 @@ std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& ad
   UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd.valid()) {
     return std::unexpected("cannot create a socket: " + reason(errno));
+  }
+  if (receiveBufferBytes > 0) {  // before connect: it sets the window the device sees
+    ::setsockopt(fd.get(), SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
   }
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&target), sizeof target) != 0) {
     if (errno != EINPROGRESS) {

@@ -24,7 +24,7 @@ class ByteWriter {
       return;
     }
     for (std::size_t i = 0; i < sizeof(T); ++i) {
-      at[i] = static_cast<std::byte>((value >> (8 * i)) & 0xFFU);
+      at[i] = static_cast<std::byte>((std::uint64_t{value} >> (8 * i)) & 0xFFU);
     }
   }
   void putBytes(std::span<const std::byte> bytes) {

@@ -24,8 +24,10 @@ struct DeviceAddress {
 
 class TcpClient {
  public:
+  // receiveBufferBytes > 0 caps the kernel's receive buffer: a host that falls behind then
+  // holds back the device, which drops its oldest frames, instead of collecting stale ones.
   [[nodiscard]] static std::expected<TcpClient, std::string> connect(
-      const DeviceAddress& address, std::chrono::milliseconds timeout);
+      const DeviceAddress& address, std::chrono::milliseconds timeout, int receiveBufferBytes = 0);
 
   // Sends everything or fails (peer closed, timeout while the peer reads nothing).
   [[nodiscard]] std::expected<void, std::string> sendAll(std::span<const std::byte> bytes,
