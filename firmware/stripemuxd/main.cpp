@@ -2,10 +2,10 @@
 // build links, and serves range images to one host at a time until SIGTERM or SIGINT
 // (docs/firmware.md). Exit codes: 0 stopped cleanly, 1 usage, 2 rejected board, 3 device error.
 #include <pthread.h>
-#include <signal.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <thread>
@@ -102,7 +102,7 @@ int run(const Options& opts) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
-  std::jthread signalThread(waitForSignal, signals, std::ref(stop));
+  const std::jthread signalThread(waitForSignal, signals, std::ref(stop));
   std::jthread network([&] { (*device)->runNetwork(stop); });
 
   timespec last{};
@@ -125,16 +125,7 @@ int run(const Options& opts) {
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // Before any thread: every thread inherits the blocked signals.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
+int parseAndRun(int argc, char** argv) {
   CLI::App app{"stripemuxd: the stripemux scanner firmware"};
   app.set_version_flag("--version", SMX_VERSION);
   Options opts;
@@ -156,4 +147,23 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 1;
   }
   return run(opts);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Before any thread: every thread inherits the blocked signals.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  try {
+    return parseAndRun(argc, argv);
+  } catch (const std::exception& e) {  // out of memory at start-up, a thread that cannot start
+    std::fprintf(stderr, "stripemuxd: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "stripemuxd: unexpected error\n");
+  }
+  return 3;
 }

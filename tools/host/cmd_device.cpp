@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -102,6 +103,39 @@ struct StreamTally {
   std::vector<double> latencyMs;  // capture → received (same clock only)
   std::vector<double> deviceMs;   // capture → queued at the device
   double decodeMsTotal = 0;
+
+  void add(const ReceivedFrame& frame, bool sameClock) {
+    ++frames;
+    ++perCamera[frame.header.camera];
+    wireBytes += frame.wireBytes;
+    rawBytes += 2 * frame.depth.size();
+    decodeMsTotal += frame.header.decodeTimeUs / 1000.0;
+    const std::int64_t captured = frame.header.captureTimestampNs;
+    deviceMs.push_back(static_cast<double>(frame.header.sentTimestampNs - captured) / 1e6);
+    if (sameClock) {
+      latencyMs.push_back(static_cast<double>(frame.receivedNs - captured) / 1e6);
+    }
+  }
+  // Frames of the camera that has the fewest (0 until every camera has sent one).
+  [[nodiscard]] int fewestPerCamera(int cameras) const {
+    if (perCamera.size() < static_cast<std::size_t>(cameras)) {
+      return 0;
+    }
+    int fewest = std::numeric_limits<int>::max();
+    for (const auto& entry : perCamera) {
+      fewest = std::min(fewest, entry.second);
+    }
+    return fewest;
+  }
+  [[nodiscard]] double bytesPerFrame() const {
+    return frames == 0 ? 0 : static_cast<double>(wireBytes) / static_cast<double>(frames);
+  }
+  [[nodiscard]] double ratio() const {
+    return wireBytes == 0 ? 0 : static_cast<double>(rawBytes) / static_cast<double>(wireBytes);
+  }
+  [[nodiscard]] double decodeMsMean() const {
+    return frames == 0 ? 0 : decodeMsTotal / static_cast<double>(frames);
+  }
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -118,6 +152,69 @@ double mean(const std::vector<double>& v) {
     sum += x;
   }
   return v.empty() ? 0 : sum / static_cast<double>(v.size());
+}
+
+Json meanAndP95(const std::vector<double>& v) {
+  Json out;
+  out["mean"] = mean(v);
+  out["p95"] = percentile(v, 0.95);
+  return out;
+}
+
+// summary.json (docs/cli.md).
+Json streamSummary(const StreamTally& tally, const DeviceInfo& info, const StreamOptions& opts,
+                   const protocol::Statistics& device, double elapsedS, bool sameClock) {
+  Json summary;
+  summary["device"] = info.address;
+  summary["board"] = info.board;
+  summary["firmware"] = info.firmwareVersion;
+  summary["frames_received"] = tally.frames;
+  for (const auto& [camera, count] : tally.perCamera) {
+    summary["frames_per_camera"][info.rig.cameras[static_cast<std::size_t>(camera)].id] = count;
+  }
+  summary["seconds"] = elapsedS;
+  summary["fps_per_camera"] = tally.fewestPerCamera(info.cameras) / elapsedS;
+  summary["bytes_per_frame"] = tally.bytesPerFrame();
+  summary["compression"] = opts.compression;
+  summary["compression_ratio"] = tally.ratio();
+  summary["mbit_per_s_at_30fps_per_camera"] = tally.bytesPerFrame() * 8 * 30 / 1e6;
+  summary["device_capture_to_queued_ms"] = meanAndP95(tally.deviceMs);
+  if (sameClock) {
+    summary["capture_to_host_ms"] = meanAndP95(tally.latencyMs);
+  }
+  summary["decode_ms_mean"] = tally.decodeMsMean();
+  Json& counters = summary["device_counters"];
+  counters["captured"] = device.framesCaptured;
+  counters["decoded"] = device.framesDecoded;
+  counters["sent"] = device.framesSent;
+  counters["dropped"] = device.framesDropped;
+  counters["capture_errors"] = device.captureErrors;
+  counters["protocol_errors"] = device.protocolErrors;
+  return summary;
+}
+
+double oneDecimal(double v) {
+  return std::round(v * 10) / 10;
+}
+
+void printSummary(const StreamTally& tally, const DeviceInfo& info, const StreamOptions& opts,
+                  const protocol::Statistics& device, double elapsedS, bool sameClock,
+                  const std::string& merged, std::ostream& out) {
+  const double perFrame = tally.bytesPerFrame();
+  out << "received " << tally.frames << " range frames in " << oneDecimal(elapsedS) << " s ("
+      << oneDecimal(tally.fewestPerCamera(info.cameras) / elapsedS)
+      << " fps per camera); the device sent " << device.framesSent << ", dropped "
+      << device.framesDropped << "\n"
+      << "  " << std::lround(perFrame / 1024) << " KiB per frame on the wire (" << opts.compression
+      << ", " << oneDecimal(tally.ratio()) << ":1), " << oneDecimal(perFrame * 8 * 30 / 1e6)
+      << " Mbit/s at 30 fps per camera\n";
+  if (sameClock) {
+    out << "  latency capture -> host " << oneDecimal(mean(tally.latencyMs)) << " ms mean, "
+        << oneDecimal(percentile(tally.latencyMs, 0.95)) << " ms p95\n";
+  }
+  out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
+      << (opts.noPly ? "" : " and .ply") << ", " << merged
+      << ", <camera>.preview.png and summary.json\n";
 }
 
 class FrameWriter {
@@ -224,35 +321,20 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
       return fail(event.error());
     }
     if (event->kind == DeviceEvent::Kind::kFrame) {
-      const ReceivedFrame& frame = event->frame;
-      if (auto ok = writer.write(frame); !ok) {
+      if (auto ok = writer.write(event->frame); !ok) {
         return fail(ok.error());
       }
-      ++tally.frames;
-      ++tally.perCamera[frame.header.camera];
-      tally.wireBytes += frame.wireBytes;
-      tally.rawBytes += 2 * frame.depth.size();
-      tally.decodeMsTotal += frame.header.decodeTimeUs / 1000.0;
-      tally.deviceMs.push_back(
-          static_cast<double>(frame.header.sentTimestampNs - frame.header.captureTimestampNs) /
-          1e6);
-      if (sameClock) {
-        tally.latencyMs.push_back(
-            static_cast<double>(frame.receivedNs - frame.header.captureTimestampNs) / 1e6);
-      }
+      tally.add(event->frame, sameClock);
     } else if (event->kind == DeviceEvent::Kind::kStatistics && stopping) {
       deviceStats = event->statistics;
     }
     const auto now = Clock::now();
     const double elapsedS = std::chrono::duration<double>(now - start).count();
-    const int fewest = tally.perCamera.size() < static_cast<std::size_t>(info.cameras)
-                           ? 0
-                           : std::ranges::min(tally.perCamera | std::views::values);
+    const int fewest = tally.fewestPerCamera(info.cameras);
     if (now - lastReport >= std::chrono::seconds(1)) {
       lastReport = now;
-      io.out << "  " << tally.frames << " frames, " << std::round(10 * fewest / elapsedS) / 10
-             << " fps per camera, "
-             << (tally.frames == 0 ? 0 : tally.wireBytes / tally.frames / 1024) << " KiB/frame\n"
+      io.out << "  " << tally.frames << " frames, " << oneDecimal(fewest / elapsedS)
+             << " fps per camera, " << std::lround(tally.bytesPerFrame() / 1024) << " KiB/frame\n"
              << std::flush;
     }
     if (!stopping && (fewest >= opts.frames || elapsedS > opts.timeoutS)) {
@@ -275,60 +357,10 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
     return fail(merged.error());
   }
 
-  const double perFrame =
-      tally.frames == 0 ? 0
-                        : static_cast<double>(tally.wireBytes) / static_cast<double>(tally.frames);
-  const double ratio = tally.wireBytes == 0 ? 0
-                                            : static_cast<double>(tally.rawBytes) /
-                                                  static_cast<double>(tally.wireBytes);
-  const double fps = tally.perCamera.empty()
-                         ? 0
-                         : std::ranges::min(tally.perCamera | std::views::values) / elapsedS;
-  Json summary = {{"device", info.address},
-                  {"board", info.board},
-                  {"firmware", info.firmwareVersion},
-                  {"frames_received", tally.frames},
-                  {"frames_per_camera", Json::object()},
-                  {"seconds", elapsedS},
-                  {"fps_per_camera", fps},
-                  {"bytes_per_frame", perFrame},
-                  {"compression", opts.compression},
-                  {"compression_ratio", ratio},
-                  {"mbit_per_s_at_30fps_per_camera", perFrame * 8 * 30 / 1e6},
-                  {"device_capture_to_queued_ms",
-                   {{"mean", mean(tally.deviceMs)}, {"p95", percentile(tally.deviceMs, 0.95)}}},
-                  {"decode_ms_mean",
-                   tally.frames == 0 ? 0 : tally.decodeMsTotal / static_cast<double>(tally.frames)},
-                  {"device_counters",
-                   {{"captured", deviceStats->framesCaptured},
-                    {"decoded", deviceStats->framesDecoded},
-                    {"sent", deviceStats->framesSent},
-                    {"dropped", deviceStats->framesDropped},
-                    {"capture_errors", deviceStats->captureErrors},
-                    {"protocol_errors", deviceStats->protocolErrors}}}};
-  for (const auto& [camera, count] : tally.perCamera) {
-    summary["frames_per_camera"][info.rig.cameras[static_cast<std::size_t>(camera)].id] = count;
-  }
-  if (sameClock) {
-    summary["capture_to_host_ms"] = {{"mean", mean(tally.latencyMs)},
-                                     {"p95", percentile(tally.latencyMs, 0.95)}};
-  }
-  std::ofstream(opts.out / "summary.json") << summary.dump(2) << "\n";
-
-  io.out << "received " << tally.frames << " range frames in " << std::round(elapsedS * 10) / 10
-         << " s (" << std::round(fps * 10) / 10 << " fps per camera); the device sent "
-         << deviceStats->framesSent << ", dropped " << deviceStats->framesDropped << "\n"
-         << "  " << std::lround(perFrame / 1024) << " KiB per frame on the wire ("
-         << opts.compression << ", " << std::round(ratio * 10) / 10 << ":1), "
-         << std::round(perFrame * 8 * 30 / 1e5) / 10 << " Mbit/s at 30 fps per camera\n";
-  if (sameClock) {
-    io.out << "  latency capture -> host " << std::round(mean(tally.latencyMs) * 10) / 10
-           << " ms mean, " << std::round(percentile(tally.latencyMs, 0.95) * 10) / 10
-           << " ms p95\n";
-  }
-  io.out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
-         << (opts.noPly ? "" : " and .ply") << ", " << *merged << ", <camera>.preview.png and "
-         << "summary.json\n";
+  const protocol::Statistics device = deviceStats.value_or(protocol::Statistics{});  // set here
+  std::ofstream(opts.out / "summary.json")
+      << streamSummary(tally, info, opts, device, elapsedS, sameClock).dump(2) << "\n";
+  printSummary(tally, info, opts, device, elapsedS, sameClock, *merged, io.out);
   return kExitOk;
 }
 

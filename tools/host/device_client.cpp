@@ -59,11 +59,12 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
   if (!reply) {
     return Fail(where + ": " + reply.error());
   }
-  if (!*reply) {
+  const auto& answer = *reply;
+  if (!answer.has_value()) {
     return Fail(where + ": the device did not answer hello within " +
                 std::to_string(timeout.count()) + " ms (is it a stripemux device?)");
   }
-  const auto& [type, payload] = **reply;
+  const auto& [type, payload] = *answer;
   if (type == MessageType::kError) {
     return Fail(where + ": " + deviceError(payload));
   }
@@ -123,10 +124,11 @@ DeviceClient::nextMessage(std::chrono::milliseconds timeout) {
       if (!next) {
         continue;  // counted by the parser; it has skipped the bad bytes
       }
-      if (!next->has_value()) {
+      const std::optional<protocol::Message>& parsed = *next;
+      if (!parsed.has_value()) {
         break;
       }
-      const auto& message = **next;
+      const protocol::Message& message = *parsed;
       return std::pair{message.type,
                        std::vector<std::byte>(message.payload.begin(), message.payload.end())};
     }
@@ -148,10 +150,11 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
   if (!message) {
     return Fail(message.error());
   }
-  if (!*message) {
+  const auto& got = *message;
+  if (!got.has_value()) {
     return DeviceEvent{};
   }
-  const auto& [type, payload] = **message;
+  const auto& [type, payload] = *got;
   switch (type) {
     case MessageType::kRangeFrame: {
       const auto frame = protocol::decodeRangeFrame(payload);

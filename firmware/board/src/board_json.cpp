@@ -115,7 +115,7 @@ void readCameras(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCon
     }
     hal::CameraConfig camera;
     camera.id = r.rigId(v, at, "id", rig.cameras[i].id, i, "camera");
-    camera.device = r.text(v, at, "device", "e.g. \"/dev/video0\" or \"sim\"").value_or("");
+    camera.device = r.text(v, at, "device", R"(e.g. "/dev/video0" or "sim")").value_or("");
     camera.format.pixelFormat =
         pixelFormat(r.word(v, at, "pixel_format", kPixelFormats).value_or(""));
     camera.format.width = rig.cameras[i].width;
@@ -201,7 +201,7 @@ void readSim(Reader& r, const Json& doc, const fs::path& dir, hal::BoardConfig& 
   }
   if (board.backend != "sim") {
     if (sim != nullptr) {
-      r.fail("sim", "only a board with \"hal\": \"sim\" has a sim section");
+      r.fail("sim", R"(only a board with "hal": "sim" has a sim section)");
     }
     return;
   }
@@ -264,7 +264,7 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
     readSim(r, doc, dir, board);
   }
   if (!r.ok()) {
-    const auto& e = *r.firstError();
+    const auto e = r.firstError().value_or(config::FieldError{});
     return std::unexpected(BoardError{{}, e.field, e.problem});
   }
   return out;

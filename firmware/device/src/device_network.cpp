@@ -174,10 +174,11 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       }
       continue;
     }
-    if (!next->has_value()) {
+    const std::optional<protocol::Message>& message = *next;
+    if (!message.has_value()) {
       break;
     }
-    onMessage(**next);
+    onMessage(*message);
   }
   pumpSend();
 }

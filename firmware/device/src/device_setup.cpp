@@ -64,7 +64,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const board::
     if (!pipeline) {
       return Fail("camera " + id + ": " + pipeline.error().message);
     }
-    slot.pipeline.emplace(std::move(*pipeline));
+    slot.pipeline = std::make_unique<algo::CameraPipeline>(*pipeline);
 
     hal::Camera& camera = *hal.cameras[i];
     const auto format = camera.configure(board.config.cameras[i].format);

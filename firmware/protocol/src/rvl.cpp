@@ -66,7 +66,7 @@ class NibbleReader {
       if (nibblesUsed_ >= 2 * in_.size()) {
         return false;
       }
-      const std::uint32_t byte = std::to_integer<std::uint32_t>(in_[nibblesUsed_ / 2]);
+      const auto byte = std::to_integer<std::uint32_t>(in_[nibblesUsed_ / 2]);
       const std::uint32_t nibble = (nibblesUsed_ % 2 == 0) ? byte >> 4 : byte & 0xFU;
       ++nibblesUsed_;
       result |= static_cast<std::uint64_t>(nibble & 0x7U) << (3 * i);

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <system_error>
 
 #include "poll_fd.hpp"
 
@@ -22,7 +23,7 @@ std::int64_t toNs(std::chrono::milliseconds timeout) {
 }
 
 std::string reason(int err) {
-  return std::strerror(err);
+  return std::system_category().message(err);
 }
 
 }  // namespace

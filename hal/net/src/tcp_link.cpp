@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <system_error>
 
 #include "poll_fd.hpp"
 
@@ -19,7 +20,7 @@ using hal::HalErrc;
 using hal::halFail;
 
 std::string systemError(const std::string& what) {
-  return what + ": " + std::strerror(errno);
+  return what + ": " + std::system_category().message(errno);
 }
 
 bool setNonBlocking(int fd) {
@@ -93,7 +94,8 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
 
 void TcpLink::refusePending() {
   while (true) {
-    UniqueFd extra(::accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
+    const UniqueFd extra(
+        ::accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
     if (!extra.valid()) {
       return;
     }

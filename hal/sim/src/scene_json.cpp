@@ -35,7 +35,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using config::describe;
 using config::element;
-using config::formatNumber;
 using config::jsonQuote;
 using config::Keys;
 using config::member;

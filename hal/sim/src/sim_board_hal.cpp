@@ -112,6 +112,7 @@ std::expected<std::unique_ptr<SimBoardHal>, std::string> SimBoardHal::create(
   }
 
   std::vector<std::string> roles;
+  roles.reserve(board.trigger.lines.size());
   for (const auto& line : board.trigger.lines) {
     roles.push_back(line.role);
   }

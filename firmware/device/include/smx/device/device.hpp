@@ -72,7 +72,7 @@ class Device {
   struct CameraSlot {
     std::vector<std::byte> memory;
     std::unique_ptr<algo::Arena> arena;
-    std::optional<algo::CameraPipeline> pipeline;
+    std::unique_ptr<algo::CameraPipeline> pipeline;
   };
 
   Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options);
