@@ -29,13 +29,14 @@ using namespace std::chrono_literals;
 
 const fs::path kSource = SMX_SOURCE_DIR;
 
-fs::path replayFrames() {
-  const fs::path dir = fs::temp_directory_path() / "smx_firmware_bench_frames";
-  if (!fs::exists(dir / "cam1_4.png")) {
+// Five turntable frames as the rig's cameras see them.
+fs::path replayFrames(const std::string& rigFile) {
+  const fs::path dir = fs::temp_directory_path() / ("smx_firmware_bench_" + rigFile);
+  if (!fs::exists(dir / "cam0_4.png")) {
     std::ostringstream out;
     std::ostringstream err;
     const std::vector<std::string> args = {
-        "sim",       "--rig",      (kSource / "boards/sim/rig_2proj_2cam.json").string(),
+        "sim",       "--rig",      (kSource / "boards/sim" / rigFile).string(),
         "--scene",   "turntable",  "--frames",
         "5",         "--no-truth", "--out",
         dir.string()};
@@ -115,7 +116,8 @@ void BM_FirmwareLoop(benchmark::State& state) {
   const auto cameras = static_cast<std::size_t>(state.range(0));
   auto board = board::loadBoard(kSource / "boards" / "sim").value();
   board.config.sim.scene.clear();
-  board.config.sim.replayDir = replayFrames();
+  board.config.sim.replayDir =
+      replayFrames(cameras == 1 ? "rig_2proj_1cam.json" : "rig_2proj_2cam.json");
   board.config.network.port = 0;
   for (auto& camera : board.config.cameras) {
     camera.format.fps = 1000;  // the loop, not the sensor, sets the pace

@@ -32,8 +32,12 @@ using namespace std::chrono_literals;
 const fs::path kSource = SMX_SOURCE_DIR;
 constexpr int kReplayFrames = 3;
 
-fs::path replayDir() {
-  return fs::temp_directory_path() / "smx_firmware_sim_test_frames";
+// Renders of the turntable by the 2-camera rig (replayDir(2)) and by the 1-camera rig.
+std::string rigFile(int cameras) {
+  return cameras == 1 ? "rig_2proj_1cam.json" : "rig_2proj_2cam.json";
+}
+fs::path replayDir(int cameras) {
+  return fs::temp_directory_path() / ("smx_firmware_sim_test_" + rigFile(cameras));
 }
 
 int cli(const std::vector<std::string>& args) {
@@ -44,13 +48,13 @@ int cli(const std::vector<std::string>& args) {
   return code;
 }
 
-// The sim board replaying `replayDir()`, on a free loopback port, with 1 or 2 cameras.
+// The sim board replaying `replayDir(cameras)`, on a free loopback port, with 1 or 2 cameras.
 board::Board simBoard(int cameras) {
   auto loaded = board::loadBoard(kSource / "boards" / "sim");
   EXPECT_TRUE(loaded.has_value());
   board::Board board = std::move(*loaded);
   board.config.sim.scene.clear();
-  board.config.sim.replayDir = replayDir();
+  board.config.sim.replayDir = replayDir(cameras);
   board.config.network.port = 0;
   board.config.network.sendBufferBytes = 64 * 1024;
   for (auto& camera : board.config.cameras) {
@@ -153,12 +157,14 @@ class RawHost {
 class FirmwareSim : public testing::Test {
  protected:
   static void SetUpTestSuite() {
-    if (fs::exists(replayDir() / ("cam1_" + std::to_string(kReplayFrames - 1) + ".png"))) {
-      return;
+    for (const int cameras : {1, 2}) {
+      if (!fs::exists(replayDir(cameras) /
+                      ("cam0_" + std::to_string(kReplayFrames - 1) + ".png"))) {
+        cli({"sim", "--rig", (kSource / "boards/sim" / rigFile(cameras)).string(), "--scene",
+             "turntable", "--frames", std::to_string(kReplayFrames), "--no-truth", "--out",
+             replayDir(cameras).string()});
+      }
     }
-    cli({"sim", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--scene",
-         "turntable", "--frames", std::to_string(kReplayFrames), "--no-truth", "--out",
-         replayDir().string()});
   }
 };
 
@@ -229,8 +235,8 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
   for (int i = 0; i < kReplayFrames; ++i) {
     const std::string n = std::to_string(i);
     cli({"decode", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--image",
-         "cam0=" + (replayDir() / ("cam0_" + n + ".png")).string(), "--image",
-         "cam1=" + (replayDir() / ("cam1_" + n + ".png")).string(), "--out",
+         "cam0=" + (replayDir(2) / ("cam0_" + n + ".png")).string(), "--image",
+         "cam1=" + (replayDir(2) / ("cam1_" + n + ".png")).string(), "--out",
          (offline / n).string()});
   }
   for (const auto& frame : frames) {
