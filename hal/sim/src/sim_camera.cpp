@@ -102,10 +102,12 @@ hal::HalResult<hal::CameraFrame> SimCamera::acquire(std::int64_t timeoutNs) {
   borrowed_[static_cast<std::size_t>(index)] = true;
   ++delivered_;
   auto& pixels = buffers_[static_cast<std::size_t>(index)];
+  // Stamped when the simulated exposure is over: rendering stands for the physical world (and
+  // is slow), not for the camera's delivery.
   return hal::CameraFrame{
       .bufferIndex = index,
       .sequence = sequence_,
-      .timestampNs = due(sequence_),
+      .timestampNs = clock_.nowNs(),
       .image = *algo::ConstRgbView::packed(pixels, format_.width, format_.height)};
 }
 

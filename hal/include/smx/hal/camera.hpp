@@ -28,7 +28,7 @@ struct CameraFormat {
 struct CameraFrame {
   int bufferIndex = -1;          // which buffer is borrowed; pass the frame back to release()
   std::uint64_t sequence = 0;    // counts frames the camera produced, dropped ones included
-  std::int64_t timestampNs = 0;  // start of exposure, the board clock (Clock::nowNs)
+  std::int64_t timestampNs = 0;  // when the frame was captured, the board clock (Clock::nowNs)
   algo::ConstRgbView image;
 };
 
