@@ -6,6 +6,7 @@
 #include "smx/hal/board_hal.hpp"
 #include "smx/hal/steady_clock.hpp"
 #include "smx/linux/gpiod_trigger.hpp"
+#include "smx/linux/libcamera_open.hpp"
 #include "smx/linux/v4l2_camera.hpp"
 #include "smx/linux/v4l2_io.hpp"
 #include "smx/net/tcp_link.hpp"
@@ -26,6 +27,7 @@ class LinuxBoardHal final : public BoardHal {
 
   lnx::SystemV4l2Io io_;  // declared first: the cameras use it until they are destroyed
   std::vector<std::unique_ptr<lnx::V4l2Camera>> cameras_;
+  std::vector<std::unique_ptr<Camera>> libcameraCameras_;
   std::vector<Camera*> cameraPointers_;
   std::unique_ptr<lnx::GpiodTrigger> trigger_;
   std::unique_ptr<net::TcpLink> link_;
@@ -76,10 +78,24 @@ std::expected<std::unique_ptr<BoardHal>, std::string> createBoardHal(const Board
   auto result = std::make_unique<LinuxBoardHal>();
   for (std::size_t i = 0; i < board.cameras.size(); ++i) {
     const CameraConfig& config = board.cameras[i];
+    if (config.device.starts_with(lnx::kLibcameraPrefix)) {
+      const std::string_view device = config.device;
+      auto camera = lnx::openLibcameraCamera(device.substr(lnx::kLibcameraPrefix.size()), config.id,
+                                             config.buffers);
+      if (!camera) {
+        return std::unexpected(cameraField(i) + ".device: " + camera.error());
+      }
+      if (auto granted = (*camera)->configure(config.format); !granted) {
+        return std::unexpected(cameraField(i) + ".format: " + config.device + ": " +
+                               granted.error().message);
+      }
+      result->cameraPointers_.push_back(camera->get());
+      result->libcameraCameras_.push_back(std::move(*camera));
+      continue;
+    }
     if (!config.device.starts_with("/dev/")) {
       return std::unexpected(cameraField(i) + ".device: '" + config.device +
-                             "' is not a V4L2 device path (this build has no libcamera or sim "
-                             "cameras)");
+                             "' is neither a V4L2 device path (/dev/videoN) nor libcamera:<id>");
     }
     auto camera = lnx::V4l2Camera::create(config.device, config.id, config.buffers, result->io_);
     if (!camera) {
