@@ -13,6 +13,7 @@
 #include "smx/board/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
+#include "smx/net/discovery.hpp"
 
 namespace {
 
@@ -93,8 +94,15 @@ int run(const Options& opts) {
       SMX_VERSION, config.name.c_str(), std::string(smx::hal::halBackend()).c_str(),
       rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
       rig.projectors.size(), (*device)->arenaBytes() / 1024);
+  const std::uint16_t tcpPort = (*hal)->hal().link.port();
   std::printf("listening on %s:%u\n", config.network.bindAddress.c_str(),
-              static_cast<unsigned>((*hal)->hal().link.port()));
+              static_cast<unsigned>(tcpPort));
+  // Discovery is a convenience: a second device on this machine (tests) goes without it.
+  auto discovery = smx::net::DiscoveryResponder::create(
+      config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
+  if (!discovery) {
+    std::printf("discovery off: %s\n", discovery.error().c_str());
+  }
   std::fflush(stdout);
 
   std::atomic<bool> stop = false;
@@ -104,6 +112,11 @@ int run(const Options& opts) {
   sigaddset(&signals, SIGINT);
   const std::jthread signalThread(waitForSignal, signals, std::ref(stop));
   std::jthread network([&] { (*device)->runNetwork(stop); });
+  std::jthread discoveryThread([&] {
+    while (discovery && !stop) {
+      (void)(*discovery)->serviceOnce(100'000'000);
+    }
+  });
 
   timespec last{};
   clock_gettime(CLOCK_MONOTONIC, &last);
@@ -121,6 +134,7 @@ int run(const Options& opts) {
     }
   }
   network.join();
+  discoveryThread.join();
   printCounters(**device, "stopped: ");
   return 0;
 }

@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "device_client.hpp"
+#include "smx/net/discovery.hpp"
 
 namespace smx::host {
 
@@ -32,16 +32,18 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   }
   if (app.get_subcommands().empty()) {
     io.out << app.help();
-    // Like a depth camera's tools: with no command, also say which device answers here.
-    constexpr auto kProbe = "127.0.0.1";
-    const auto device = DeviceClient::connect(kProbe, std::chrono::milliseconds(300));
-    io.out << "\nDevices: ";
-    if (device) {
-      io.out << device->info().address << " (board " << device->info().board << ", firmware "
-             << device->info().firmwareVersion << ")\n";
+    // Like a depth camera's tools: with no command, also list the devices that answer.
+    const auto found = net::discoverDevices({"255.255.255.255", "127.0.0.1"}, net::kDiscoveryPort,
+                                            std::chrono::milliseconds(300));
+    io.out << "\nDevices:";
+    if (!found || found->empty()) {
+      io.out << " none answered (start one with stripemuxd --board boards/sim; a device "
+             << "elsewhere: stripemux info --device HOST)\n";
     } else {
-      io.out << "none answered on " << kProbe << ":5555 (start one with stripemuxd --board "
-             << "boards/sim; other hosts: stripemux info --device HOST)\n";
+      io.out << "\n";
+      for (const auto& device : *found) {
+        io.out << "  " << device.address << "  board " << device.board << "\n";
+      }
     }
   }
   return exitCode;
