@@ -7,50 +7,26 @@
 
 #include <algorithm>
 #include <atomic>
-#include <filesystem>
-#include <sstream>
 #include <thread>
 #include <vector>
 
-#include "cli.hpp"
+#include "replay_board.hpp"
 #include "smx/board/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
+#include "smx/hal/steady_clock.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
-#include "smx/protocol/rig_json.hpp"
 #include "smx/protocol/stream_parser.hpp"
 
 namespace {
 
 using namespace smx;
-namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-const fs::path kSource = SMX_SOURCE_DIR;
-
-// Five turntable frames as the rig's cameras see them.
-fs::path replayFrames(const std::string& rigFile) {
-  const fs::path dir = fs::temp_directory_path() / ("smx_firmware_bench_" + rigFile);
-  if (!fs::exists(dir / "cam0_4.png")) {
-    std::ostringstream out;
-    std::ostringstream err;
-    const std::vector<std::string> args = {
-        "sim",       "--rig",      (kSource / "boards/sim" / rigFile).string(),
-        "--scene",   "turntable",  "--frames",
-        "5",         "--no-truth", "--out",
-        dir.string()};
-    if (host::runCli(args, {out, err}) != 0) {
-      throw std::runtime_error(err.str());
-    }
-  }
-  return dir;
-}
-
+// The device's clock: capture timestamps and this host share it on one machine.
 std::int64_t nowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return hal::SteadyClock().nowNs();
 }
 
 // Receives and parses everything, recording what a host would measure.
@@ -114,18 +90,7 @@ class Host {
 
 void BM_FirmwareLoop(benchmark::State& state) {
   const auto cameras = static_cast<std::size_t>(state.range(0));
-  auto board = board::loadBoard(kSource / "boards" / "sim").value();
-  board.config.sim.scene.clear();
-  board.config.sim.replayDir =
-      replayFrames(cameras == 1 ? "rig_2proj_1cam.json" : "rig_2proj_2cam.json");
-  board.config.network.port = 0;
-  for (auto& camera : board.config.cameras) {
-    camera.format.fps = 1000;  // the loop, not the sensor, sets the pace
-  }
-  if (cameras == 1) {
-    board.rig = protocol::loadRig(kSource / "boards/sim/rig_2proj_1cam.json").value();
-    board.config.cameras.resize(1);
-  }
+  const board::Board board = test::replayBoard(static_cast<int>(cameras), 5);
   auto boardHal = hal::createBoardHal(board.config, board.rig).value();
   device::DeviceOptions options;
   options.decodeThreads = static_cast<int>(state.range(1));

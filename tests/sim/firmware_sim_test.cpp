@@ -14,6 +14,7 @@
 #include "alloc_counter.hpp"
 #include "cli.hpp"
 #include "device_client.hpp"
+#include "replay_board.hpp"
 #include "smx/board/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
@@ -32,14 +33,6 @@ using namespace std::chrono_literals;
 const fs::path kSource = SMX_SOURCE_DIR;
 constexpr int kReplayFrames = 3;
 
-// Renders of the turntable by the 2-camera rig (replayDir(2)) and by the 1-camera rig.
-std::string rigFile(int cameras) {
-  return cameras == 1 ? "rig_2proj_1cam.json" : "rig_2proj_2cam.json";
-}
-fs::path replayDir(int cameras) {
-  return fs::temp_directory_path() / ("smx_firmware_sim_test_" + rigFile(cameras));
-}
-
 int cli(const std::vector<std::string>& args) {
   std::ostringstream out;
   std::ostringstream err;
@@ -48,22 +41,11 @@ int cli(const std::vector<std::string>& args) {
   return code;
 }
 
-// The sim board replaying `replayDir(cameras)`, on a free loopback port, with 1 or 2 cameras.
+// The sim board replaying its rig's renders, with a small send buffer so that a slow host is
+// felt after a few frames.
 board::Board simBoard(int cameras) {
-  auto loaded = board::loadBoard(kSource / "boards" / "sim");
-  EXPECT_TRUE(loaded.has_value());
-  board::Board board = std::move(*loaded);
-  board.config.sim.scene.clear();
-  board.config.sim.replayDir = replayDir(cameras);
-  board.config.network.port = 0;
+  board::Board board = test::replayBoard(cameras, kReplayFrames);
   board.config.network.sendBufferBytes = 64 * 1024;
-  for (auto& camera : board.config.cameras) {
-    camera.format.fps = 1000;  // as fast as the pipeline goes
-  }
-  if (cameras == 1) {
-    board.rig = protocol::loadRig(kSource / "boards" / "sim" / "rig_2proj_1cam.json").value();
-    board.config.cameras.resize(1);
-  }
   return board;
 }
 
@@ -158,12 +140,7 @@ class FirmwareSim : public testing::Test {
  protected:
   static void SetUpTestSuite() {
     for (const int cameras : {1, 2}) {
-      if (!fs::exists(replayDir(cameras) /
-                      ("cam0_" + std::to_string(kReplayFrames - 1) + ".png"))) {
-        cli({"sim", "--rig", (kSource / "boards/sim" / rigFile(cameras)).string(), "--scene",
-             "turntable", "--frames", std::to_string(kReplayFrames), "--no-truth", "--out",
-             replayDir(cameras).string()});
-      }
+      (void)test::replayFrames(cameras, kReplayFrames);  // rendered once, before any timing
     }
   }
 };
@@ -235,9 +212,10 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
   for (int i = 0; i < kReplayFrames; ++i) {
     const std::string n = std::to_string(i);
     cli({"decode", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--image",
-         "cam0=" + (replayDir(2) / ("cam0_" + n + ".png")).string(), "--image",
-         "cam1=" + (replayDir(2) / ("cam1_" + n + ".png")).string(), "--out",
-         (offline / n).string()});
+         "cam0=" + (test::replayFrames(2, kReplayFrames) / ("cam0_" + n + ".png")).string(),
+         "--image",
+         "cam1=" + (test::replayFrames(2, kReplayFrames) / ("cam1_" + n + ".png")).string(),
+         "--out", (offline / n).string()});
   }
   for (const auto& frame : frames) {
     // The simulated camera replays image k for its k-th frame; no capture failed here, so the

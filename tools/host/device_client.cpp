@@ -1,7 +1,6 @@
 #include "device_client.hpp"
 
-#include <ctime>
-
+#include "smx/hal/steady_clock.hpp"
 #include "smx/protocol/rig_json.hpp"
 
 namespace smx::host {
@@ -14,12 +13,6 @@ using protocol::MessageType;
 // About five range frames: enough to ride out a slow file write, small enough that a host that
 // keeps falling behind sees fresh frames (the device drops the oldest) rather than old ones.
 constexpr int kReceiveBufferBytes = 1 << 20;
-
-std::int64_t monotonicNs() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
-}
 
 std::string deviceError(std::span<const std::byte> payload) {
   const auto error = protocol::decodeError(payload);
@@ -168,7 +161,7 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
         return Fail(std::string("bad range frame: ") + ok.error().message);
       }
       received.wireBytes = protocol::kHeaderBytes + payload.size();
-      received.receivedNs = monotonicNs();
+      received.receivedNs = hal::SteadyClock().nowNs();
       DeviceEvent event;
       event.kind = DeviceEvent::Kind::kFrame;
       event.frame = std::move(received);

@@ -24,10 +24,6 @@ constexpr std::array<char, 5> kAnswerTag = {'S', 'M', 'X', 'P', '!'};
 constexpr std::byte kVersion{1};
 constexpr std::size_t kRequestBytes = kRequestTag.size() + 1;
 
-std::string systemError(const std::string& what) {
-  return what + ": " + std::system_category().message(errno);
-}
-
 bool startsWith(std::span<const std::byte> bytes, const std::array<char, 5>& tag) {
   return bytes.size() > tag.size() &&
          std::equal(tag.begin(), tag.end(), bytes.begin(),
@@ -56,13 +52,13 @@ std::expected<std::unique_ptr<DiscoveryResponder>, std::string> DiscoveryRespond
   }
   UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!socket.valid()) {
-    return Fail(systemError("discovery: cannot create a UDP socket"));
+    return Fail(detail::systemError("discovery: cannot create a UDP socket"));
   }
   const int yes = 1;
   ::setsockopt(socket.get(), SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   if (::bind(socket.get(), reinterpret_cast<const sockaddr*>(&*address), sizeof *address) != 0) {
-    return Fail(systemError("discovery: cannot listen on UDP " + bindAddress + ":" +
-                            std::to_string(udpPort)));
+    return Fail(detail::systemError("discovery: cannot listen on UDP " + bindAddress + ":" +
+                                    std::to_string(udpPort)));
   }
   sockaddr_in bound{};
   socklen_t length = sizeof bound;
@@ -118,7 +114,7 @@ std::expected<std::vector<FoundDevice>, std::string> discoverDevices(
     std::chrono::milliseconds wait) {
   const UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!socket.valid()) {
-    return Fail(systemError("cannot create a UDP socket"));
+    return Fail(detail::systemError("cannot create a UDP socket"));
   }
   const int yes = 1;
   ::setsockopt(socket.get(), SOL_SOCKET, SO_BROADCAST, &yes, sizeof yes);

@@ -5,8 +5,11 @@
 #include <cerrno>
 #include <cstdint>
 #include <limits>
+#include <string>
+#include <system_error>
 
-// poll() on one or two descriptors with a timeout in nanoseconds, restarted after signals.
+// poll() on one or two descriptors with a timeout in nanoseconds, restarted after signals, and
+// the other small helpers the socket code shares.
 namespace smx::net::detail {
 
 [[nodiscard]] inline int timeoutMs(std::int64_t timeoutNs) {
@@ -16,6 +19,11 @@ namespace smx::net::detail {
   const std::int64_t ms = (timeoutNs + 999'999) / 1'000'000;
   return ms > std::numeric_limits<int>::max() ? std::numeric_limits<int>::max()
                                               : static_cast<int>(ms);
+}
+
+// "what: <errno's text>" (thread-safe, unlike strerror).
+[[nodiscard]] inline std::string systemError(const std::string& what, int err = errno) {
+  return what + ": " + std::system_category().message(err);
 }
 
 // A non-blocking call that could not proceed now (Linux: EWOULDBLOCK is EAGAIN).

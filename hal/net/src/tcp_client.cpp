@@ -22,10 +22,6 @@ std::int64_t toNs(std::chrono::milliseconds timeout) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
 }
 
-std::string reason(int err) {
-  return std::system_category().message(err);
-}
-
 }  // namespace
 
 std::expected<DeviceAddress, std::string> parseDeviceAddress(const std::string& text,
@@ -66,14 +62,14 @@ std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& ad
 
   UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd.valid()) {
-    return std::unexpected("cannot create a socket: " + reason(errno));
+    return std::unexpected(detail::systemError("cannot create a socket"));
   }
   if (receiveBufferBytes > 0) {  // before connect: it sets the window the device sees
     ::setsockopt(fd.get(), SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
   }
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&target), sizeof target) != 0) {
     if (errno != EINPROGRESS) {
-      return std::unexpected("cannot connect to " + where + ": " + reason(errno));
+      return std::unexpected(detail::systemError("cannot connect to " + where));
     }
     pollfd pending{.fd = fd.get(), .events = POLLOUT, .revents = 0};
     const int ready = detail::pollRetry(&pending, 1, toNs(timeout));
@@ -87,7 +83,7 @@ std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& ad
       err = errno;
     }
     if (err != 0) {
-      return std::unexpected("cannot connect to " + where + ": " + reason(err));
+      return std::unexpected(detail::systemError("cannot connect to " + where, err));
     }
   }
   const int yes = 1;
@@ -104,7 +100,7 @@ std::expected<void, std::string> TcpClient::sendAll(std::span<const std::byte> b
       continue;
     }
     if (sent < 0 && !detail::wouldBlock(errno)) {
-      return std::unexpected("sending to the device failed: " + reason(errno));
+      return std::unexpected(detail::systemError("sending to the device failed"));
     }
     pollfd fd{.fd = fd_.get(), .events = POLLOUT, .revents = 0};
     if (detail::pollRetry(&fd, 1, toNs(timeout)) == 0) {
@@ -120,7 +116,7 @@ std::expected<std::size_t, std::string> TcpClient::receiveSome(std::span<std::by
   pollfd fd{.fd = fd_.get(), .events = POLLIN, .revents = 0};
   const int ready = detail::pollRetry(&fd, 1, toNs(timeout));
   if (ready < 0) {
-    return std::unexpected("waiting for the device failed: " + reason(errno));
+    return std::unexpected(detail::systemError("waiting for the device failed"));
   }
   if (ready == 0) {
     return 0;
@@ -133,7 +129,7 @@ std::expected<std::size_t, std::string> TcpClient::receiveSome(std::span<std::by
     return 0;
   }
   return std::unexpected(got == 0 ? std::string("the device closed the connection")
-                                  : "receiving from the device failed: " + reason(errno));
+                                  : detail::systemError("receiving from the device failed"));
 }
 
 }  // namespace smx::net

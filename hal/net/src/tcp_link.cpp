@@ -19,10 +19,6 @@ namespace {
 using hal::HalErrc;
 using hal::halFail;
 
-std::string systemError(const std::string& what) {
-  return what + ": " + std::system_category().message(errno);
-}
-
 bool setNonBlocking(int fd) {
   const int flags = ::fcntl(fd, F_GETFL);
   return flags >= 0 && ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) == 0;
@@ -45,20 +41,20 @@ std::expected<std::unique_ptr<TcpLink>, std::string> TcpLink::create(
   }
   UniqueFd listener(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
   if (!listener.valid()) {
-    return std::unexpected(systemError("cannot create a socket"));
+    return std::unexpected(detail::systemError("cannot create a socket"));
   }
   const int yes = 1;
   ::setsockopt(listener.get(), SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   if (::bind(listener.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-    return std::unexpected(systemError("cannot listen on " + where));
+    return std::unexpected(detail::systemError("cannot listen on " + where));
   }
   if (::listen(listener.get(), 4) != 0 || !setNonBlocking(listener.get())) {
-    return std::unexpected(systemError("cannot listen on " + where));
+    return std::unexpected(detail::systemError("cannot listen on " + where));
   }
   sockaddr_in bound{};
   socklen_t length = sizeof bound;
   if (::getsockname(listener.get(), reinterpret_cast<sockaddr*>(&bound), &length) != 0) {
-    return std::unexpected(systemError("cannot read the port of " + where));
+    return std::unexpected(detail::systemError("cannot read the port of " + where));
   }
   return std::unique_ptr<TcpLink>(
       new TcpLink(std::move(listener), ntohs(bound.sin_port), network.sendBufferBytes));
