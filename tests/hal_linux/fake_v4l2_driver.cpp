@@ -57,8 +57,13 @@ int FakeV4l2Driver::finishFrame(int index, std::uint32_t bytesUsed, std::uint32_
   if (index < 0) {
     return -1;  // no buffer to fill: a dropped frame
   }
-  done_.push_back(
-      Done{.index = index, .bytesUsed = bytesUsed, .flags = flags, .sequence = sequence});
+  // Stamped when done, as a driver does.
+  done_.push_back(Done{.index = index,
+                       .bytesUsed = bytesUsed,
+                       .flags = flags,
+                       .sequence = sequence,
+                       .timestampSec = timestampSec_,
+                       .timestampUsec = timestampUsec_});
   return index;
 }
 
@@ -207,8 +212,8 @@ int FakeV4l2Driver::dequeue(v4l2_buffer& buffer) {
   buffer.bytesused = done.bytesUsed;
   buffer.flags = done.flags | V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
   buffer.sequence = done.sequence;
-  buffer.timestamp.tv_sec = timestampSec_;
-  buffer.timestamp.tv_usec = timestampUsec_;
+  buffer.timestamp.tv_sec = done.timestampSec;
+  buffer.timestamp.tv_usec = done.timestampUsec;
   buffer.length =
       static_cast<std::uint32_t>(buffers_[static_cast<std::size_t>(done.index)].memory.size());
   return 0;

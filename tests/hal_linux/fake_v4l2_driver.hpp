@@ -56,10 +56,13 @@ class FakeV4l2Driver final : public lnx::V4l2Io {
     return finishFrame(takeQueued(), bytesUsed, flags);
   }
   void setNextSequence(std::uint32_t sequence) { sequence_ = sequence; }
+  // The time stamp of the frames produced from now on.
   void setTimestamp(std::int64_t sec, std::int64_t usec) {
     timestampSec_ = sec;
     timestampUsec_ = usec;
   }
+  // What nowNs() answers: the camera's clock, against which frames are stale or fresh.
+  void setNowNs(std::int64_t now) { nowNs_ = now; }
 
   // What the camera did to the driver.
   [[nodiscard]] const v4l2_pix_format& format() const { return format_; }
@@ -81,6 +84,7 @@ class FakeV4l2Driver final : public lnx::V4l2Io {
                                                std::int64_t offset) override;
   int munmap(void* address, std::size_t length) override;
   [[nodiscard]] int poll(int fd, short events, std::int64_t timeoutNs, short& revents) override;
+  [[nodiscard]] std::int64_t nowNs() override { return nowNs_; }
 
  private:
   static constexpr std::uint32_t kPage = 4096;
@@ -112,11 +116,14 @@ class FakeV4l2Driver final : public lnx::V4l2Io {
     std::uint32_t bytesUsed;
     std::uint32_t flags;
     std::uint32_t sequence;
+    std::int64_t timestampSec;
+    std::int64_t timestampUsec;
   };
   std::vector<Done> done_;
   std::uint32_t sequence_ = 0;
   std::int64_t timestampSec_ = 100;
   std::int64_t timestampUsec_ = 0;
+  std::int64_t nowNs_ = 0;
 };
 
 }  // namespace smx::test

@@ -212,6 +212,41 @@ TEST_F(V4l2CameraTest, Rgb24FramesAreTheMappedBufferWithTheDriversStrideTimeAndS
   EXPECT_EQ(driver_.queuedCount(), 4);
 }
 
+TEST_F(V4l2CameraTest, FramesExposedBeforeTheCallAreRequeuedAndTheNextOneIsReturned) {
+  // Given a camera at 30 fps (33.3 ms a frame) called at t = 100 s, with two frames already
+  // done: one ending at 99.9 s and one ending at 100.02 s, so exposed from 99.987 s (both before
+  // the call), then one ending at 100.04 s (exposed from 100.007 s, after the call)
+  auto camera = streaming(PixelFormat::kRgb24);
+  driver_.setNowNs(100'000'000'000);
+  driver_.setTimestamp(99, 900'000);
+  produce();
+  driver_.setTimestamp(100, 20'000);
+  produce();
+  driver_.setTimestamp(100, 40'000);
+  const int fresh = produce();
+  // When acquired
+  auto frame = camera->acquire(kTimeoutNs);
+  // Then the stale ones went back to the driver and the fresh one is returned
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->bufferIndex, fresh);
+  EXPECT_EQ(frame->timestampNs, 100'040'000'000);
+  EXPECT_EQ(camera->staleFrames(), 2U);
+  EXPECT_EQ(driver_.queuedCount(), 3);
+}
+
+TEST_F(V4l2CameraTest, StartOfExposureStampsAreFreshFromTheCall) {
+  auto camera = streaming(PixelFormat::kRgb24);
+  driver_.setNowNs(100'000'000'000);
+  driver_.setTimestamp(99, 999'000);
+  produce();
+  driver_.setTimestamp(100, 1'000);
+  driver_.produceFrame([](std::span<std::byte>) {}, V4L2_BUF_FLAG_TSTAMP_SRC_SOE);
+  auto frame = camera->acquire(kTimeoutNs);
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->timestampNs, 100'001'000'000);
+  EXPECT_EQ(camera->staleFrames(), 1U);
+}
+
 TEST_F(V4l2CameraTest, Bgr24FramesAreConvertedIntoTheCamerasOwnBuffer) {
   auto camera = streaming(PixelFormat::kBgr24);
   const int index = produce();
@@ -426,6 +461,7 @@ class DeadDequeue final : public V4l2Io {
   int poll(int fd, short events, std::int64_t timeoutNs, short& revents) override {
     return inner_.poll(fd, events, timeoutNs, revents);
   }
+  std::int64_t nowNs() override { return inner_.nowNs(); }
 
  private:
   V4l2Io& inner_;

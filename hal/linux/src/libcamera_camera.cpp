@@ -4,6 +4,7 @@
 #include <libcamera/libcamera.h>
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <condition_variable>
@@ -173,8 +174,12 @@ class LibcameraCamera final : public hal::Camera {
     if (state_ != CameraState::kStreaming) {
       return halFail(HalErrc::kInvalidState, "acquire while not streaming");
     }
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::nanoseconds(timeoutNs < 0 ? 0 : timeoutNs);
+    const auto called = std::chrono::steady_clock::now();
+    const auto deadline = called + std::chrono::nanoseconds(timeoutNs < 0 ? 0 : timeoutNs);
+    // Frames are stamped with CLOCK_MONOTONIC (steady_clock) at their end, conservatively.
+    const std::int64_t freshStampNs =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(called.time_since_epoch()).count() +
+        1'000'000'000 / std::max(format_.fps, 1);
     while (true) {
       lc::Request* request = nullptr;
       {
@@ -192,9 +197,11 @@ class LibcameraCamera final : public hal::Camera {
       const lc::FrameBuffer* buffer = request->buffers().begin()->second;
       const lc::FrameMetadata& metadata = buffer->metadata();
       const auto index = static_cast<std::size_t>(request->cookie());
+      // A bad frame, or one exposed before the call (hal::Camera::acquire): back to the camera.
       if (request->status() != lc::Request::RequestComplete ||
-          metadata.status != lc::FrameMetadata::FrameSuccess) {
-        request->reuse(lc::Request::ReuseBuffers);  // a bad frame: back to the camera
+          metadata.status != lc::FrameMetadata::FrameSuccess ||
+          static_cast<std::int64_t>(metadata.timestamp) < freshStampNs) {
+        request->reuse(lc::Request::ReuseBuffers);
         (void)camera_->queueRequest(request);
         continue;
       }

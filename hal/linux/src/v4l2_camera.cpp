@@ -72,11 +72,13 @@ std::string driverName(const v4l2_capability& capability) {
   return {name, std::find(name, name + sizeof capability.driver, '\0')};
 }
 
-// The clock V4L2 stamps buffers with; acquire() measures its timeout on it.
-std::int64_t monotonicNowNs() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<std::int64_t>(now.tv_sec) * kNsPerS + now.tv_nsec;
+// The earliest time stamp of a frame whose exposure began at or after `calledNs`. Drivers stamp
+// the end of the frame unless they say otherwise; a frame takes a frame period.
+std::int64_t freshFrameStampNs(std::uint32_t bufferFlags, std::int64_t calledNs,
+                               std::int64_t periodNs) {
+  return (bufferFlags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE
+             ? calledNs
+             : calledNs + periodNs;
 }
 
 v4l2_buffer mmapBuffer(int index) {
@@ -312,10 +314,12 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
   if (borrowedCount_ == bufferCount()) {
     return halFail(HalErrc::kBusy, "every camera buffer is borrowed");
   }
-  const std::int64_t deadlineNs = monotonicNowNs() + std::max<std::int64_t>(timeoutNs, 0);
+  const std::int64_t calledNs = io_.nowNs();
+  const std::int64_t periodNs = kNsPerS / std::max(format_.fps, 1);
+  const std::int64_t deadlineNs = calledNs + std::max<std::int64_t>(timeoutNs, 0);
   for (;;) {
     short revents = 0;
-    const std::int64_t leftNs = std::max<std::int64_t>(deadlineNs - monotonicNowNs(), 0);
+    const std::int64_t leftNs = std::max<std::int64_t>(deadlineNs - io_.nowNs(), 0);
     const int polled = io_.poll(fd_, POLLIN, leftNs, revents);
     if (polled == -EINTR) {
       continue;
@@ -353,6 +357,17 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
     }
     const std::int64_t timestampNs = static_cast<std::int64_t>(buffer.timestamp.tv_sec) * kNsPerS +
                                      static_cast<std::int64_t>(buffer.timestamp.tv_usec) * kNsPerUs;
+    const bool monotonic =
+        (buffer.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+    if (monotonic && timestampNs < freshFrameStampNs(buffer.flags, calledNs, periodNs)) {
+      // Exposed before the call, so before the projectors were lit: a free-running camera
+      // fills its queue while the pipeline works. Back to the driver, and wait for a new one.
+      ++staleFrames_;
+      if (auto queued = queue(index); !queued) {
+        return std::unexpected(queued.error());
+      }
+      continue;
+    }
     auto frame = deliver(index, buffer.bytesused, timestampNs, buffer.sequence);
     if (!frame) {
       (void)queue(index);  // not handed out: back to the driver

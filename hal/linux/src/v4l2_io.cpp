@@ -66,4 +66,10 @@ int SystemV4l2Io::poll(int fd, short events, std::int64_t timeoutNs, short& reve
   return result;
 }
 
+std::int64_t SystemV4l2Io::nowNs() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * kNsPerS + now.tv_nsec;
+}
+
 }  // namespace smx::lnx

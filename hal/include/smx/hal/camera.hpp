@@ -46,7 +46,8 @@ class Camera {
   [[nodiscard]] virtual HalResult<void> start() = 0;
   // Returns every borrowed buffer; frames acquired before are invalid afterwards.
   [[nodiscard]] virtual HalResult<void> stop() = 0;
-  // Waits at most timeoutNs for the next frame.
+  // Waits at most timeoutNs for the next frame: one whose exposure began after the call, so that
+  // it sees the projectors lit before the call. Frames the camera took earlier are dropped.
   [[nodiscard]] virtual HalResult<CameraFrame> acquire(std::int64_t timeoutNs) = 0;
   [[nodiscard]] virtual HalResult<void> release(const CameraFrame& frame) = 0;
   // After kDisconnected: tries to reopen the device and return to the state it was in

@@ -57,6 +57,8 @@ class V4l2Camera final : public hal::Camera {
   [[nodiscard]] int bufferCount() const { return static_cast<int>(buffers_.size()); }
   // Counters (per frame: counted, never logged).
   [[nodiscard]] std::uint64_t corruptFrames() const { return corruptFrames_; }
+  // Frames exposed before acquire() was called, skipped (see hal::Camera::acquire).
+  [[nodiscard]] std::uint64_t staleFrames() const { return staleFrames_; }
   [[nodiscard]] std::uint64_t disconnects() const { return disconnects_; }
 
  private:
@@ -99,6 +101,7 @@ class V4l2Camera final : public hal::Camera {
   std::uint32_t lastSequence_ = 0;
   bool firstFrame_ = true;
   std::uint64_t corruptFrames_ = 0;
+  std::uint64_t staleFrames_ = 0;
   std::uint64_t disconnects_ = 0;
 };
 

@@ -26,6 +26,8 @@ class V4l2Io {
   virtual int munmap(void* address, std::size_t length) = 0;
   // Waits at most timeoutNs for `events` on fd: 1 with `revents` filled, 0 on timeout, or -errno.
   [[nodiscard]] virtual int poll(int fd, short events, std::int64_t timeoutNs, short& revents) = 0;
+  // CLOCK_MONOTONIC, the clock drivers stamp buffers with.
+  [[nodiscard]] virtual std::int64_t nowNs() = 0;
 
  protected:
   V4l2Io() = default;
@@ -43,6 +45,7 @@ class SystemV4l2Io final : public V4l2Io {
                                                std::int64_t offset) override;
   int munmap(void* address, std::size_t length) override;
   [[nodiscard]] int poll(int fd, short events, std::int64_t timeoutNs, short& revents) override;
+  [[nodiscard]] std::int64_t nowNs() override;
 };
 
 }  // namespace smx::lnx
