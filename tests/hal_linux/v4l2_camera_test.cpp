@@ -424,9 +424,12 @@ TEST_F(V4l2CameraTest, UnplugWhileStreamingIsDisconnectedAndReopenRestoresStream
   EXPECT_EQ(driver_.openFds(), 0);
   EXPECT_EQ(camera->acquire(kTimeoutNs).error().code, HalErrc::kDisconnected);
   EXPECT_EQ(camera->start().error().code, HalErrc::kDisconnected);
-  // A frame held across the loss is still readable and can be given back.
+  // A frame held across the loss is still readable and can be given back; the last one given
+  // back unmaps the lost device's buffers, so that its driver can be unloaded.
+  EXPECT_EQ(driver_.mappedCount(), 4);
   EXPECT_EQ(held->image(2, 1), (algo::Rgb8{15, 14, 13}));
   EXPECT_TRUE(camera->release(*held));
+  EXPECT_EQ(driver_.mappedCount(), 0);
   // While the device is absent, reopen keeps failing
   EXPECT_EQ(camera->reopen().error().code, HalErrc::kDisconnected);
   // When it is back, reopen restores the format and streaming
@@ -466,6 +469,17 @@ class DeadDequeue final : public V4l2Io {
  private:
   V4l2Io& inner_;
 };
+
+TEST_F(V4l2CameraTest, ALostDeviceWithNoFrameBorrowedIsUnmappedAtOnce) {
+  auto camera = streaming(PixelFormat::kRgb24);
+  driver_.unplug();
+  EXPECT_EQ(camera->acquire(kTimeoutNs).error().code, HalErrc::kDisconnected);
+  EXPECT_EQ(driver_.mappedCount(), 0);
+  driver_.plug();
+  ASSERT_TRUE(camera->reopen());
+  EXPECT_EQ(driver_.mappedCount(), 4);
+  EXPECT_EQ(camera->state(), CameraState::kStreaming);
+}
 
 TEST_F(V4l2CameraTest, DequeueFailingWithNoDeviceIsDisconnected) {
   DeadDequeue io(driver_);

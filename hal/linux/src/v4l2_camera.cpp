@@ -429,8 +429,15 @@ hal::HalResult<void> V4l2Camera::release(const hal::CameraFrame& frame) {
   }
   buffer.borrowed = false;
   --borrowedCount_;
-  // A lost device: the buffer is ours to give back but there is no queue to put it in.
-  return present ? queue(frame.bufferIndex) : hal::HalResult<void>{};
+  if (present) {
+    return queue(frame.bufferIndex);
+  }
+  // A lost device: no queue to put it in. The last frame given back lets go of the mappings,
+  // which hold the driver (it could not be unloaded).
+  if (borrowedCount_ == 0) {
+    freeBuffers();
+  }
+  return {};
 }
 
 hal::HalResult<void> V4l2Camera::queue(int index) {
@@ -512,6 +519,10 @@ std::unexpected<hal::HalError> V4l2Camera::markLost(int err) {
   if (state_ == CameraState::kStreaming) {
     resumeStreaming_ = true;
     state_ = CameraState::kStopped;
+  }
+  // Mappings hold the driver's file, and so the driver; kept only for frames still borrowed.
+  if (borrowedCount_ == 0) {
+    freeBuffers();
   }
   return halFail(HalErrc::kDisconnected, "the camera device is gone", err);
 }
