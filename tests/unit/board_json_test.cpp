@@ -50,6 +50,13 @@ TEST(BoardJson, TheShippedBoardsLoad) {
   EXPECT_EQ(rpi->config.cameras[0].format.pixelFormat, hal::PixelFormat::kYuyv);
   EXPECT_EQ(rpi->config.trigger.lines[1].offset, 27U);
   EXPECT_EQ(rpi->config.network.bindAddress, "0.0.0.0");
+
+  // The kernel tests' board shares the simulator's rig through a relative path.
+  const auto qemu = loadBoard(kBoards / "qemu");
+  ASSERT_TRUE(qemu.has_value()) << qemu.error().message();
+  EXPECT_EQ(qemu->config.cameras[0].format.pixelFormat, hal::PixelFormat::kRgb24);
+  EXPECT_EQ(qemu->rig.cameras[0].id, "cam0");
+  EXPECT_EQ(qemu->rig.projectors.size(), 2U);
 }
 
 TEST(BoardJson, ErrorsNameTheField) {

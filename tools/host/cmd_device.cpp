@@ -100,11 +100,12 @@ struct StreamTally {
   std::uint64_t frames = 0;
   std::uint64_t wireBytes = 0;
   std::uint64_t rawBytes = 0;
-  std::vector<double> latencyMs;  // capture → received (same clock only)
+  std::vector<double> latencyMs;  // capture → received (device on loopback)
   std::vector<double> deviceMs;   // capture → queued at the device
   double decodeMsTotal = 0;
+  bool clocksAgree = true;
 
-  void add(const ReceivedFrame& frame, bool sameClock) {
+  void add(const ReceivedFrame& frame, bool loopback) {
     ++frames;
     ++perCamera[frame.header.camera];
     wireBytes += frame.wireBytes;
@@ -112,10 +113,16 @@ struct StreamTally {
     decodeMsTotal += frame.header.decodeTimeUs / 1000.0;
     const std::int64_t captured = frame.header.captureTimestampNs;
     deviceMs.push_back(static_cast<double>(frame.header.sentTimestampNs - captured) / 1e6);
-    if (sameClock) {
-      latencyMs.push_back(static_cast<double>(frame.receivedNs - captured) / 1e6);
+    if (loopback) {
+      const double ms = static_cast<double>(frame.receivedNs - captured) / 1e6;
+      // Loopback may still be another clock (a port forwarded into a virtual machine or over
+      // ssh): a frame received before it was captured, or a minute after, gives it away.
+      clocksAgree = clocksAgree && ms >= 0 && ms < 60'000;
+      latencyMs.push_back(ms);
     }
   }
+  // Capture → host needs the device's clock to be the host's.
+  [[nodiscard]] bool hostLatencyKnown() const { return clocksAgree && !latencyMs.empty(); }
   // Frames of the camera that has the fewest (0 until every camera has sent one).
   [[nodiscard]] int fewestPerCamera(int cameras) const {
     if (perCamera.size() < static_cast<std::size_t>(cameras)) {
@@ -163,7 +170,7 @@ Json meanAndP95(const std::vector<double>& v) {
 
 // summary.json (docs/cli.md).
 Json streamSummary(const StreamTally& tally, const DeviceInfo& info, const StreamOptions& opts,
-                   const protocol::Statistics& device, double elapsedS, bool sameClock) {
+                   const protocol::Statistics& device, double elapsedS) {
   Json summary;
   summary["device"] = info.address;
   summary["board"] = info.board;
@@ -179,7 +186,7 @@ Json streamSummary(const StreamTally& tally, const DeviceInfo& info, const Strea
   summary["compression_ratio"] = tally.ratio();
   summary["mbit_per_s_at_30fps_per_camera"] = tally.bytesPerFrame() * 8 * 30 / 1e6;
   summary["device_capture_to_queued_ms"] = meanAndP95(tally.deviceMs);
-  if (sameClock) {
+  if (tally.hostLatencyKnown()) {
     summary["capture_to_host_ms"] = meanAndP95(tally.latencyMs);
   }
   summary["decode_ms_mean"] = tally.decodeMsMean();
@@ -198,8 +205,8 @@ double oneDecimal(double v) {
 }
 
 void printSummary(const StreamTally& tally, const DeviceInfo& info, const StreamOptions& opts,
-                  const protocol::Statistics& device, double elapsedS, bool sameClock,
-                  const std::string& merged, std::ostream& out) {
+                  const protocol::Statistics& device, double elapsedS, const std::string& merged,
+                  std::ostream& out) {
   const double perFrame = tally.bytesPerFrame();
   out << "received " << tally.frames << " range frames in " << oneDecimal(elapsedS) << " s ("
       << oneDecimal(tally.fewestPerCamera(info.cameras) / elapsedS)
@@ -208,10 +215,13 @@ void printSummary(const StreamTally& tally, const DeviceInfo& info, const Stream
       << "  " << std::lround(perFrame / 1024) << " KiB per frame on the wire (" << opts.compression
       << ", " << oneDecimal(tally.ratio()) << ":1), " << oneDecimal(perFrame * 8 * 30 / 1e6)
       << " Mbit/s at 30 fps per camera\n";
-  if (sameClock) {
-    out << "  latency capture -> host " << oneDecimal(mean(tally.latencyMs)) << " ms mean, "
-        << oneDecimal(percentile(tally.latencyMs, 0.95)) << " ms p95\n";
+  out << "  latency capture -> queued on the device " << oneDecimal(mean(tally.deviceMs))
+      << " ms mean, " << oneDecimal(percentile(tally.deviceMs, 0.95)) << " ms p95";
+  if (tally.hostLatencyKnown()) {
+    out << "; capture -> host " << oneDecimal(mean(tally.latencyMs)) << " ms mean, "
+        << oneDecimal(percentile(tally.latencyMs, 0.95)) << " ms p95";
   }
+  out << "\n";
   out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
       << (opts.noPly ? "" : " and .ply") << ", " << merged
       << ", <camera>.preview.png and summary.json\n";
@@ -306,7 +316,7 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
 
   FrameWriter writer(opts, info);
   StreamTally tally;
-  const bool sameClock = isLoopback(info.address);
+  const bool loopback = isLoopback(info.address);
   const auto start = Clock::now();
   auto lastReport = start;
   std::optional<protocol::Statistics> deviceStats;
@@ -324,7 +334,7 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
       if (auto ok = writer.write(event->frame); !ok) {
         return fail(ok.error());
       }
-      tally.add(event->frame, sameClock);
+      tally.add(event->frame, loopback);
     } else if (event->kind == DeviceEvent::Kind::kStatistics && stopping) {
       deviceStats = event->statistics;
     }
@@ -359,8 +369,8 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
 
   const protocol::Statistics device = deviceStats.value_or(protocol::Statistics{});  // set here
   std::ofstream(opts.out / "summary.json")
-      << streamSummary(tally, info, opts, device, elapsedS, sameClock).dump(2) << "\n";
-  printSummary(tally, info, opts, device, elapsedS, sameClock, *merged, io.out);
+      << streamSummary(tally, info, opts, device, elapsedS).dump(2) << "\n";
+  printSummary(tally, info, opts, device, elapsedS, *merged, io.out);
   return kExitOk;
 }
 
