@@ -94,9 +94,16 @@ class LibcameraCamera final : public hal::Camera {
     stream.pixelFormat = libcameraFormat(wanted.pixelFormat);
     stream.size = size;
     stream.bufferCount = static_cast<unsigned>(bufferCount_);
-    if (config_->validate() == lc::CameraConfiguration::Invalid ||
-        stream.pixelFormat != libcameraFormat(wanted.pixelFormat) || stream.size != size) {
+    if (config_->validate() == lc::CameraConfiguration::Invalid) {
       return halFail(HalErrc::kNotSupported, "the camera cannot deliver that size and format");
+    }
+    if (stream.pixelFormat != libcameraFormat(wanted.pixelFormat) || stream.size != size) {
+      // validate() moved the stream to the nearest it can do: say what that is. (HalError
+      // holds a C string, so the message lives in the camera.)
+      configureError_ = "the camera cannot deliver " + size.toString() + "-" +
+                        libcameraFormat(wanted.pixelFormat).toString() + "; the nearest it can is " +
+                        stream.toString();
+      return halFail(HalErrc::kNotSupported, configureError_.c_str());
     }
     if (camera_->configure(config_.get()) < 0) {
       return halFail(HalErrc::kIo, "libcamera refused the configuration");
@@ -302,6 +309,7 @@ class LibcameraCamera final : public hal::Camera {
   hal::CameraFormat format_;
   CameraState state_ = CameraState::kUnconfigured;
   std::unique_ptr<lc::CameraConfiguration> config_;
+  std::string configureError_;
   std::unique_ptr<lc::FrameBufferAllocator> allocator_;
   std::vector<Slot> slots_;
 
