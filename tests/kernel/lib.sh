@@ -39,7 +39,7 @@ kernel_init() {
   local abi=${headers#linux-headers-}
   abi=${abi%-amd64}
   KVER=$abi-$KDEB_ARCH
-  KCACHE=${SMX_KERNEL_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/stripemux/kernel}/$KVER
+  KCACHE=${SMX_KERNEL_CACHE:-${XDG_CACHE_HOME:-${HOME:-/tmp}/.cache}/stripemux/kernel}/$KVER
   mkdir -p "$KCACHE"
 }
 
@@ -59,7 +59,7 @@ fetch_deb() {
     kernel_die "cannot download $package: $(tail -1 "$downloads/apt.err")"
   local deb
   deb=$(find "$downloads" -name "${package%%:*}_*.deb" | head -1)
-  rm -rf "$KCACHE/$dir"
+  rm -rf "${KCACHE:?}/$dir"
   dpkg-deb -x "$deb" "$KCACHE/$dir"
   touch "$KCACHE/$dir/.unpacked"
 }
@@ -137,11 +137,11 @@ stage_modules() {
     local files
     files=$(modprobe -d "$staging" -S "$KVER" --show-depends "$name" 2>&1) ||
       kernel_die "module $name: $files"
-    for file in $(awk '$1 == "insmod" {print $2}' <<<"$files"); do
+    while read -r file; do
       local relative=${file#"$tree"/}
       mkdir -p "$GROOT/lib/modules/$KVER/$(dirname "$relative")"
       cp "$file" "$GROOT/lib/modules/$KVER/$relative"
-    done
+    done < <(awk '$1 == "insmod" {print $2}' <<<"$files")
   done
   cp "$tree"/modules.order "$tree"/modules.builtin "$tree"/modules.builtin.modinfo \
     "$GROOT/lib/modules/$KVER/"

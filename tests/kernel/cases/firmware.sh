@@ -58,7 +58,11 @@ case_run() {
   local port stop_port frames=3
   port=$(free_port)
   stop_port=$(free_port)
+  while [ "$stop_port" = "$port" ]; do stop_port=$(free_port); done
+  # A console left by an earlier run must not be taken for this guest's.
+  rm -f "$WORK/console.log" "$WORK/console.log.txt" "$WORK/qemu.pid"
   KERNEL_GUEST_CPUS=2 run_guest "$WORK/initramfs.gz" "$WORK/console.log" 900 \
+    -pidfile "$WORK/qemu.pid" \
     -netdev "user,id=n0,hostfwd=tcp:127.0.0.1:$port-:5555,hostfwd=tcp:127.0.0.1:$stop_port-:7000" \
     -device virtio-net-pci,netdev=n0 &
   local guest=$!
@@ -66,6 +70,7 @@ case_run() {
   until grep -q '^SMX-READY' "$WORK/console.log" 2>/dev/null; do
     if ! kill -0 "$guest" 2>/dev/null || [ $waited -ge 300 ]; then
       kernel_log "the guest's firmware never started"
+      stop_guest_now
       wait "$guest" || true
       return 1
     fi
@@ -77,7 +82,10 @@ case_run() {
     --timeout 600 --no-ply || status=$?
   kernel_log "streamed $frames frames in $((SECONDS - stream_start)) s (stripemux exit $status)"
   # Ask the guest to stop its firmware, then wait for its verdict (SIGTERM must exit 0).
-  (exec 3<>"/dev/tcp/127.0.0.1/$stop_port") 2>/dev/null || kernel_log "cannot reach the guest to stop it"
+  if ! (exec 3<>"/dev/tcp/127.0.0.1/$stop_port") 2>/dev/null; then
+    kernel_log "cannot reach the guest to stop it"
+    stop_guest_now
+  fi
   wait "$guest" || status=1
   [ "$status" -eq 0 ] || return 1
 
@@ -96,4 +104,10 @@ case_run() {
   fi
   [ "$status" -ne 0 ] || kernel_log "$received depth images received, each identical to stripemux decode"
   return "$status"
+}
+
+# When the host side has failed there is nothing to wait for.
+stop_guest_now() {
+  [ -f "$WORK/qemu.pid" ] && kill "$(cat "$WORK/qemu.pid")" 2>/dev/null
+  return 0
 }

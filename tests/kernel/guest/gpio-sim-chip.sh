@@ -2,7 +2,7 @@
 # configfs, with lines 0 and 1 named after the projectors they trigger on the qemu board, and
 # prints the sysfs folder of its lines (sim_gpio<N>/value).
 make_gpio_sim_chip() {
-  local config=/sys/kernel/config/gpio-sim/chip0
+  config=/sys/kernel/config/gpio-sim/chip0
   mkdir "$config" "$config/bank0" || return 1
   echo "$1" >"$config/bank0/num_lines"
   for line in 0 1; do

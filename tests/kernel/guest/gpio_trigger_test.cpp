@@ -31,7 +31,7 @@ std::int64_t monotonicNs() {
 }
 
 std::string env(const char* name) {
-  const char* value = std::getenv(name);
+  const char* value = std::getenv(name);  // NOLINT(concurrency-mt-unsafe): read before threads
   return value != nullptr ? value : "";
 }
 
@@ -92,7 +92,7 @@ class LineSampler {
   }
   ~LineSampler() {
     stop();
-    for (int fd : fds_) {
+    for (const int fd : fds_) {
       ::close(fd);
     }
   }
@@ -162,7 +162,7 @@ TEST(GpioSimTrigger, TheBoardsLinesAreLitAroundEveryCaptureAndOnlyThen) {
   ASSERT_EQ(real.cameras.size(), 1U);
   RecordingCamera camera(*real.cameras[0]);
   hal::Camera* cameras[] = {&camera};
-  hal::Hal recorded{cameras, real.trigger, real.link, real.clock};
+  const hal::Hal recorded{cameras, real.trigger, real.link, real.clock};
 
   device::DeviceOptions options;
   options.acquireTimeoutNs = 5'000'000'000;

@@ -9,8 +9,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
+#include <system_error>
 #include <thread>
 
 #include "smx/linux/v4l2_camera.hpp"
@@ -64,6 +64,7 @@ algo::Rgb8 meanColour(const algo::ConstRgbView& image, int x, int y) {
 // The centre of each of vivid's eight colour bars, halfway down (below its on-screen text).
 std::vector<algo::Rgb8> barColours(const algo::ConstRgbView& image) {
   std::vector<algo::Rgb8> bars;
+  bars.reserve(8);
   for (int bar = 0; bar < 8; ++bar) {
     bars.push_back(meanColour(image, bar * 80 + 40, 300));
   }
@@ -74,7 +75,7 @@ TEST(V4l2Vivid, NegotiatesRgb24AndYuyvAt640x480AndBothShowTheSameColourBars) {
   SystemV4l2Io io;
   std::vector<algo::Rgb8> seen[2];
   int i = 0;
-  for (PixelFormat format : {PixelFormat::kRgb24, PixelFormat::kYuyv}) {
+  for (const PixelFormat format : {PixelFormat::kRgb24, PixelFormat::kYuyv}) {
     auto stream = startCamera(io, format, 25);
     ASSERT_TRUE(stream.camera);
     EXPECT_EQ(stream.granted.width, 640);
@@ -88,15 +89,16 @@ TEST(V4l2Vivid, NegotiatesRgb24AndYuyvAt640x480AndBothShowTheSameColourBars) {
     ASSERT_TRUE(stream.camera->release(*frame));
   }
   // 75 % colour bars: white, yellow, cyan, green, magenta, red, blue, black.
-  const bool expected[8][3] = {{1, 1, 1}, {1, 1, 0}, {0, 1, 1}, {0, 1, 0},
-                               {1, 0, 1}, {1, 0, 0}, {0, 0, 1}, {0, 0, 0}};
+  const int expected[8][3] = {{1, 1, 1}, {1, 1, 0}, {0, 1, 1}, {0, 1, 0},
+                              {1, 0, 1}, {1, 0, 0}, {0, 0, 1}, {0, 0, 0}};
   for (int bar = 0; bar < 8; ++bar) {
     const algo::Rgb8 rgb = seen[0][static_cast<std::size_t>(bar)];
     const algo::Rgb8 yuv = seen[1][static_cast<std::size_t>(bar)];
     const int rgbChannels[3] = {rgb.r, rgb.g, rgb.b};
     const int yuvChannels[3] = {yuv.r, yuv.g, yuv.b};
     for (int c = 0; c < 3; ++c) {
-      EXPECT_EQ(rgbChannels[c] > 128, expected[bar][c]) << "bar " << bar << " channel " << c;
+      EXPECT_EQ(rgbChannels[c] > 128 ? 1 : 0, expected[bar][c])
+          << "bar " << bar << " channel " << c;
       // The driver's YUYV, converted by pixel_convert, against its own RGB24.
       EXPECT_NEAR(yuvChannels[c], rgbChannels[c], 4) << "bar " << bar << " channel " << c;
     }
@@ -162,7 +164,8 @@ void disconnectVivid() {
   const int fd = ::open(kDevice, O_RDWR);
   ASSERT_GE(fd, 0);
   v4l2_control control{.id = kVividDisconnect, .value = 0};
-  ASSERT_EQ(::ioctl(fd, VIDIOC_S_CTRL, &control), 0) << std::strerror(errno);
+  ASSERT_EQ(::ioctl(fd, VIDIOC_S_CTRL, &control), 0)
+      << std::error_code(errno, std::generic_category()).message();
   ::close(fd);
 }
 
@@ -192,13 +195,13 @@ TEST(V4l2Vivid, RecoversWhenTheDriverIsUnloadedAndReloaded) {
   EXPECT_TRUE(stream.camera->lost());
 
   // With nothing holding it, the driver can go; the camera cannot come back while it is gone.
-  ASSERT_EQ(std::system("rmmod vivid"), 0);
+  ASSERT_EQ(std::system("rmmod vivid"), 0);  // NOLINT(concurrency-mt-unsafe): one thread
   ASSERT_TRUE(waitForDevice(false));
   auto absent = stream.camera->reopen();
   ASSERT_FALSE(absent);
   EXPECT_EQ(absent.error().code, HalErrc::kDisconnected);
 
-  ASSERT_EQ(std::system("modprobe vivid"), 0);
+  ASSERT_EQ(std::system("modprobe vivid"), 0);  // NOLINT(concurrency-mt-unsafe): one thread
   ASSERT_TRUE(waitForDevice(true));
   auto reopened = stream.camera->reopen();
   ASSERT_TRUE(reopened) << reopened.error().message;

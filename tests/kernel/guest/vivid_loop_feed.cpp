@@ -18,11 +18,12 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace {
@@ -34,9 +35,9 @@ constexpr std::uint32_t kLoopVideo = kVividBase + 37;
 constexpr int kWidth = 640;
 constexpr int kHeight = 480;
 
+// Caught in main(), which reports it and exits 1.
 [[noreturn]] void fail(const std::string& what) {
-  std::fprintf(stderr, "vivid_loop_feed: %s: %s\n", what.c_str(), std::strerror(errno));
-  std::exit(1);
+  throw std::runtime_error(what + ": " + std::error_code(errno, std::generic_category()).message());
 }
 
 void xioctl(int fd, unsigned long request, void* arg, const char* name) {
@@ -80,24 +81,41 @@ void setControl(int fd, std::uint32_t id, int value, const char* name) {
 
 }  // namespace
 
+namespace {
+
+[[noreturn]] void feed(const char* captureDevice, const char* outputDevice, const char* ppm);
+
+}  // namespace
+
 int main(int argc, char** argv) {
   if (argc != 4) {
     std::fprintf(stderr, "usage: vivid_loop_feed CAPTURE_DEV OUTPUT_DEV IMAGE.ppm\n");
     return 2;
   }
-  const std::vector<char> image = readPpm(argv[3]);
+  try {
+    feed(argv[1], argv[2], argv[3]);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vivid_loop_feed: %s\n", e.what());
+    return 1;
+  }
+}
 
-  const int capture = ::open(argv[1], O_RDWR);
+namespace {
+
+void feed(const char* captureDevice, const char* outputDevice, const char* ppm) {
+  const std::vector<char> image = readPpm(ppm);
+
+  const int capture = ::open(captureDevice, O_RDWR);
   if (capture < 0) {
-    fail(argv[1]);
+    fail(captureDevice);
   }
   setTimings(capture, "capture VIDIOC_S_DV_TIMINGS");
   setControl(capture, kOsdTextMode, 2, "OSD text mode");
   setControl(capture, kLoopVideo, 1, "loop video");
 
-  const int output = ::open(argv[2], O_RDWR);
+  const int output = ::open(outputDevice, O_RDWR);
   if (output < 0) {
-    fail(argv[2]);
+    fail(outputDevice);
   }
   setTimings(output, "output VIDIOC_S_DV_TIMINGS");
   v4l2_format format{};
@@ -140,7 +158,7 @@ int main(int argc, char** argv) {
   }
   int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
   xioctl(output, VIDIOC_STREAMON, &type, "output VIDIOC_STREAMON");
-  std::printf("vivid_loop_feed: looping %s into %s\n", argv[3], argv[1]);
+  std::printf("vivid_loop_feed: looping %s into %s\n", ppm, captureDevice);
   std::fflush(stdout);
   // The same picture, again and again: each buffer goes back as soon as the driver shows it.
   for (;;) {
@@ -151,3 +169,5 @@ int main(int argc, char** argv) {
     xioctl(output, VIDIOC_QBUF, &buffer, "output VIDIOC_QBUF");
   }
 }
+
+}  // namespace
