@@ -5,8 +5,9 @@
 //   build/host/tests/bench/demux_bench
 //   build/host/tests/bench/demux_bench --benchmark_filter=640x480_2proj
 //
-// Frames: the simulator renders the plane scene once at start-up for rig_2proj_1cam and
-// rig_3proj_1cam at 640×480, and for the same rigs with camera 0 scaled to 1280×960.
+// Frames: the simulator renders the plane scene once at start-up for rig_2proj_1cam (with one
+// projector, its first, and with both) and rig_3proj_1cam at 640×480, and for the same rigs
+// with camera 0 scaled to 1280×960.
 // Per configuration:
 //   <cfg>/sobel        cv::Sobel(frame, dst, CV_16S, 1, 0, 3) on the frame as CV_8UC3;
 //   <cfg>/demux        Demultiplexer::run() (the whole frame; arena from workspaceBytes());
@@ -294,16 +295,25 @@ algo::Rig doubled(algo::Rig rig) {
   return rig;
 }
 
-std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled) {
+// The example rig, with camera 0 at twice the size if `scaled`, and only its first
+// `projectors` projectors when that is not 0.
+algo::Rig benchRig(const std::string& rigFile, bool scaled, int projectors) {
+  algo::Rig rig = smx::test::loadExampleRig(rigFile);
+  if (scaled) {
+    rig = doubled(std::move(rig));
+  }
+  if (projectors > 0) {
+    rig.projectors.resize(static_cast<std::size_t>(projectors));
+  }
+  return rig;
+}
+
+std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int keep = 0) {
   auto c = std::make_unique<Config>();
   const smx::test::SimRequest request{rigFile, "plane"};
   const auto started = Clock::now();
-  if (scaled) {
-    c->frame = smx::test::renderSimFrame(doubled(smx::test::loadExampleRig(rigFile)),
-                                         smx::test::loadNamedScene("plane"), request);
-  } else {
-    c->frame = smx::test::renderSimFrame(request);
-  }
+  c->frame = smx::test::renderSimFrame(benchRig(rigFile, scaled, keep),
+                                       smx::test::loadNamedScene("plane"), request);
   const double renderS = std::chrono::duration<double>(Clock::now() - started).count();
   const int w = c->frame.image.width;
   const int h = c->frame.image.height;
@@ -458,6 +468,7 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Config>> configs;
   try {
     for (const bool scaled : {false, true}) {
+      configs.push_back(makeConfig("rig_2proj_1cam.json", scaled, 1));
       for (const char* rig : {"rig_2proj_1cam.json", "rig_3proj_1cam.json"}) {
         configs.push_back(makeConfig(rig, scaled));
       }
