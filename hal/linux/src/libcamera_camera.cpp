@@ -101,8 +101,8 @@ class LibcameraCamera final : public hal::Camera {
       // validate() moved the stream to the nearest it can do: say what that is. (HalError
       // holds a C string, so the message lives in the camera.)
       configureError_ = "the camera cannot deliver " + size.toString() + "-" +
-                        libcameraFormat(wanted.pixelFormat).toString() + "; the nearest it can is " +
-                        stream.toString();
+                        libcameraFormat(wanted.pixelFormat).toString() +
+                        "; the nearest it can is " + stream.toString();
       return halFail(HalErrc::kNotSupported, configureError_.c_str());
     }
     if (camera_->configure(config_.get()) < 0) {
