@@ -8,6 +8,8 @@
 # $SMX_KERNEL_CACHE (default ~/.cache/stripemux/kernel).
 
 SMX_SKIP=77  # CTest's SKIP_RETURN_CODE
+# depmod, modprobe and modinfo live in sbin, which a user's PATH may lack.
+PATH=$PATH:/usr/sbin:/sbin
 
 kernel_log() { echo "kernel: $*" >&2; }
 kernel_die() {
