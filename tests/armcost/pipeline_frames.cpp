@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "ppm_io.hpp"
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/rig_json.hpp"
@@ -39,79 +40,6 @@ struct Options {
   int frames = 1;
   Stage until = Stage::kMerge;
 };
-
-struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<algo::Rgb8> pixels;
-};
-
-// Reads the header token by token as netpbm does: whitespace and # comments between tokens.
-bool readPpmToken(std::istream& in, std::string& token) {
-  token.clear();
-  int c = in.get();
-  while (c != EOF && (std::isspace(c) != 0 || c == '#')) {
-    if (c == '#') {
-      while (c != EOF && c != '\n') {
-        c = in.get();
-      }
-    }
-    c = in.get();
-  }
-  while (c != EOF && std::isspace(c) == 0 && c != '#') {
-    token.push_back(static_cast<char>(c));
-    c = in.get();
-  }
-  if (c == '#') {
-    in.unget();  // a comment right after a token belongs to the next gap
-  }
-  // The single whitespace after the last header token is consumed with it, as P6 requires.
-  return !token.empty();
-}
-
-bool parsePositive(const std::string& token, int limit, int& value) {
-  if (token.empty() || token.size() > 6 ||
-      token.find_first_not_of("0123456789") != std::string::npos) {
-    return false;
-  }
-  value = std::stoi(token);
-  return value > 0 && value <= limit;
-}
-
-// Binary P6 with maxval 255: what tests/kernel's png_to_ppm writes (the board build has no PNG
-// library). Every failure names the file.
-std::expected<Image, std::string> readPpm(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return std::unexpected(path + ": cannot open");
-  }
-  std::string magic;
-  std::string w;
-  std::string h;
-  std::string maxval;
-  if (!readPpmToken(in, magic) || magic != "P6") {
-    return std::unexpected(path + ": not a binary PPM (P6)");
-  }
-  Image image;
-  if (!readPpmToken(in, w) || !readPpmToken(in, h) || !parsePositive(w, 1 << 16, image.width) ||
-      !parsePositive(h, 1 << 16, image.height)) {
-    return std::unexpected(path + ": bad PPM size");
-  }
-  int max = 0;
-  if (!readPpmToken(in, maxval) || !parsePositive(maxval, 65535, max) || max != 255) {
-    return std::unexpected(path + ": PPM maxval must be 255 (8 bits per channel), got '" + maxval +
-                           "'");
-  }
-  image.pixels.resize(static_cast<std::size_t>(image.width) *
-                      static_cast<std::size_t>(image.height));
-  const auto bytes = static_cast<std::streamsize>(image.pixels.size() * sizeof(algo::Rgb8));
-  in.read(reinterpret_cast<char*>(image.pixels.data()), bytes);
-  if (in.gcount() != bytes) {
-    return std::unexpected(path + ": truncated: " + std::to_string(in.gcount()) + " of " +
-                           std::to_string(bytes) + " pixel bytes");
-  }
-  return image;
-}
 
 // Pixels with a result, counted without branches so that a run of 0 frames (over zeroed planes)
 // executes the same instructions as a run of N.
@@ -161,7 +89,7 @@ int run(const Options& opts) {
     std::fprintf(stderr, "pipeline_frames: %s\n", rig.error().message().c_str());
     return kExitBadInput;
   }
-  auto image = readPpm(opts.image);
+  auto image = test::readPpm(opts.image);
   if (!image) {
     std::fprintf(stderr, "pipeline_frames: %s\n", image.error().c_str());
     return kExitBadInput;

@@ -52,11 +52,18 @@ class V4l2CameraTest : public testing::Test {
     return camera;
   }
 
-  int produce() {
+  int produce(std::uint32_t flags = 0) {
     const v4l2_pix_format f = driver_.format();
-    return driver_.produceFrame([&](std::span<std::byte> memory) {
-      fillRows(memory, f.bytesperline, f.bytesperline, f.height);
-    });
+    return driver_.produceFrame(
+        [&](std::span<std::byte> memory) {
+          fillRows(memory, f.bytesperline, f.bytesperline, f.height);
+        },
+        flags);
+  }
+  // A frame the driver stamps sec.usec (its flags say which end of the exposure that is).
+  int produceStamped(std::int64_t sec, std::int64_t usec, std::uint32_t flags = 0) {
+    driver_.setTimestamp(sec, usec);
+    return produce(flags);
   }
 
   test::FakeV4l2Driver driver_;
@@ -218,12 +225,9 @@ TEST_F(V4l2CameraTest, FramesExposedBeforeTheCallAreRequeuedAndTheNextOneIsRetur
   // the call), then one ending at 100.04 s (exposed from 100.007 s, after the call)
   auto camera = streaming(PixelFormat::kRgb24);
   driver_.setNowNs(100'000'000'000);
-  driver_.setTimestamp(99, 900'000);
-  produce();
-  driver_.setTimestamp(100, 20'000);
-  produce();
-  driver_.setTimestamp(100, 40'000);
-  const int fresh = produce();
+  produceStamped(99, 900'000);
+  produceStamped(100, 20'000);
+  const int fresh = produceStamped(100, 40'000);
   // When acquired
   auto frame = camera->acquire(kTimeoutNs);
   // Then the stale ones went back to the driver and the fresh one is returned
@@ -237,10 +241,8 @@ TEST_F(V4l2CameraTest, FramesExposedBeforeTheCallAreRequeuedAndTheNextOneIsRetur
 TEST_F(V4l2CameraTest, StartOfExposureStampsAreFreshFromTheCall) {
   auto camera = streaming(PixelFormat::kRgb24);
   driver_.setNowNs(100'000'000'000);
-  driver_.setTimestamp(99, 999'000);
-  produce();
-  driver_.setTimestamp(100, 1'000);
-  driver_.produceFrame([](std::span<std::byte>) {}, V4L2_BUF_FLAG_TSTAMP_SRC_SOE);
+  produceStamped(99, 999'000);
+  produceStamped(100, 1'000, V4L2_BUF_FLAG_TSTAMP_SRC_SOE);
   auto frame = camera->acquire(kTimeoutNs);
   ASSERT_TRUE(frame);
   EXPECT_EQ(frame->timestampNs, 100'001'000'000);

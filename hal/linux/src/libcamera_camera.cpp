@@ -4,7 +4,6 @@
 #include <libcamera/libcamera.h>
 #include <sys/mman.h>
 
-#include <algorithm>
 #include <array>
 #include <chrono>
 #include <condition_variable>
@@ -13,6 +12,7 @@
 #include <system_error>
 #include <vector>
 
+#include "fresh_frame.hpp"
 #include "smx/linux/libcamera_open.hpp"
 #include "smx/linux/pixel_convert.hpp"
 
@@ -183,10 +183,10 @@ class LibcameraCamera final : public hal::Camera {
     }
     const auto called = std::chrono::steady_clock::now();
     const auto deadline = called + std::chrono::nanoseconds(timeoutNs < 0 ? 0 : timeoutNs);
-    // Frames are stamped with CLOCK_MONOTONIC (steady_clock) at their end, conservatively.
-    const std::int64_t freshStampNs =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(called.time_since_epoch()).count() +
-        1'000'000'000 / std::max(format_.fps, 1);
+    // Frames are stamped with CLOCK_MONOTONIC (steady_clock), taken as end-of-frame stamps.
+    const std::int64_t freshStampNs = detail::freshFrameStampNs(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(called.time_since_epoch()).count(),
+        format_.fps, false);
     while (true) {
       lc::Request* request = nullptr;
       {

@@ -10,6 +10,7 @@
 #include <system_error>
 #include <utility>
 
+#include "fresh_frame.hpp"
 #include "smx/linux/pixel_convert.hpp"
 
 namespace smx::lnx {
@@ -70,15 +71,6 @@ const char* capabilityProblem(const v4l2_capability& capability) {
 std::string driverName(const v4l2_capability& capability) {
   const auto* name = reinterpret_cast<const char*>(capability.driver);
   return {name, std::find(name, name + sizeof capability.driver, '\0')};
-}
-
-// The earliest time stamp of a frame whose exposure began at or after `calledNs`. Drivers stamp
-// the end of the frame unless they say otherwise; a frame takes a frame period.
-std::int64_t freshFrameStampNs(std::uint32_t bufferFlags, std::int64_t calledNs,
-                               std::int64_t periodNs) {
-  return (bufferFlags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE
-             ? calledNs
-             : calledNs + periodNs;
 }
 
 v4l2_buffer mmapBuffer(int index) {
@@ -315,7 +307,6 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
     return halFail(HalErrc::kBusy, "every camera buffer is borrowed");
   }
   const std::int64_t calledNs = io_.nowNs();
-  const std::int64_t periodNs = kNsPerS / std::max(format_.fps, 1);
   const std::int64_t deadlineNs = calledNs + std::max<std::int64_t>(timeoutNs, 0);
   for (;;) {
     short revents = 0;
@@ -359,7 +350,10 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
                                      static_cast<std::int64_t>(buffer.timestamp.tv_usec) * kNsPerUs;
     const bool monotonic =
         (buffer.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
-    if (monotonic && timestampNs < freshFrameStampNs(buffer.flags, calledNs, periodNs)) {
+    const bool startOfExposure =
+        (buffer.flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE;
+    if (monotonic &&
+        timestampNs < detail::freshFrameStampNs(calledNs, format_.fps, startOfExposure)) {
       // Exposed before the call, so before the projectors were lit: a free-running camera
       // fills its queue while the pipeline works. Back to the driver, and wait for a new one.
       ++staleFrames_;

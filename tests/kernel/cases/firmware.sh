@@ -24,11 +24,8 @@ case_stage() {
   stage_file "$SOURCE_DIR/boards/qemu" /boards/qemu
   stage_file "$rig" /boards/sim/rig_2proj_1cam.json
   stage_file "$KERNEL_DIR/guest/gpio-sim-chip.sh" /gpio-sim-chip.sh
-  if build_extra_modules; then
-    stage_modules gpio-sim
-  else
-    kernel_die "gpio-sim cannot be built for $KARCH"
-  fi
+  build_extra_modules || kernel_die "gpio-sim cannot be built for $KARCH"
+  stage_modules gpio-sim
   cat >"$GROOT/test.sh" <<'GUEST'
 . /gpio-sim-chip.sh
 make_gpio_sim_chip 4 >/dev/null || exit 1

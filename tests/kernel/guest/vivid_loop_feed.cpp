@@ -19,14 +19,17 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
+#include "ppm_io.hpp"
+
 namespace {
+
+namespace algo = smx::algo;
 
 // vivid's private controls (drivers/media/test-drivers/vivid/vivid-ctrls.c).
 constexpr std::uint32_t kVividBase = 0x00f00000 | 0xf000;
@@ -48,25 +51,16 @@ void xioctl(int fd, unsigned long request, void* arg, const char* name) {
   }
 }
 
-// A binary PPM (P6, maxval 255) of kWidth x kHeight.
-std::vector<char> readPpm(const char* path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string magic;
-  int width = 0;
-  int height = 0;
-  int maxval = 0;
-  in >> magic >> width >> height >> maxval;
-  in.get();
-  if (!in || magic != "P6" || width != kWidth || height != kHeight || maxval != 255) {
-    errno = EINVAL;
-    fail(std::string(path) + " is not a 640x480 P6 PPM");
+// The frame to loop, which must be kWidth x kHeight.
+std::vector<algo::Rgb8> readFrame(const char* path) {
+  auto image = smx::test::readPpm(path);
+  if (!image) {
+    throw std::runtime_error(image.error());
   }
-  std::vector<char> pixels(static_cast<std::size_t>(kWidth) * kHeight * 3);
-  if (!in.read(pixels.data(), static_cast<std::streamsize>(pixels.size()))) {
-    errno = EINVAL;
-    fail(std::string(path) + " is truncated");
+  if (image->width != kWidth || image->height != kHeight) {
+    throw std::runtime_error(std::string(path) + " is not 640x480");
   }
-  return pixels;
+  return std::move(image->pixels);
 }
 
 void setTimings(int fd, const char* side) {
@@ -103,7 +97,7 @@ int main(int argc, char** argv) {
 namespace {
 
 void feed(const char* captureDevice, const char* outputDevice, const char* ppm) {
-  const std::vector<char> image = readPpm(ppm);
+  const std::vector<algo::Rgb8> image = readFrame(ppm);
 
   const int capture = ::open(captureDevice, O_RDWR);
   if (capture < 0) {
@@ -151,7 +145,7 @@ void feed(const char* captureDevice, const char* outputDevice, const char* ppm) 
     auto* bytes = static_cast<char*>(mapped);
     constexpr std::size_t kRowBytes = static_cast<std::size_t>(kWidth) * 3;
     for (std::size_t y = 0; y < kHeight; ++y) {
-      std::memcpy(bytes + y * stride, image.data() + y * kRowBytes, kRowBytes);
+      std::memcpy(bytes + y * stride, image.data() + y * kWidth, kRowBytes);
     }
     buffer.bytesused = static_cast<std::uint32_t>(stride * kHeight);
     xioctl(output, VIDIOC_QBUF, &buffer, "output VIDIOC_QBUF");
