@@ -51,11 +51,11 @@
 #include <vector>
 
 #include "demux_kernels.hpp"
-#include "sim_frame.hpp"
 #include "smx/algo/arena.hpp"
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/encoding_prediction.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 namespace {
 
@@ -259,7 +259,7 @@ class Stages {
 // the start-up Sobel time. Not movable once built (the demultiplexer points into memory).
 struct Config {
   std::string name;
-  smx::test::SimFrame frame;
+  smx::eval::SimFrame frame;
   algo::DemuxLayout layout;
   std::size_t arenaBytes = 0;
   std::vector<std::byte> memory;
@@ -298,7 +298,7 @@ algo::Rig doubled(algo::Rig rig) {
 // The example rig, with camera 0 at twice the size if `scaled`, and only its first
 // `projectors` projectors when that is not 0.
 algo::Rig benchRig(const std::string& rigFile, bool scaled, int projectors) {
-  algo::Rig rig = smx::test::loadExampleRig(rigFile);
+  algo::Rig rig = smx::eval::loadExampleRig(rigFile);
   if (scaled) {
     rig = doubled(std::move(rig));
   }
@@ -310,10 +310,10 @@ algo::Rig benchRig(const std::string& rigFile, bool scaled, int projectors) {
 
 std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int keep = 0) {
   auto c = std::make_unique<Config>();
-  const smx::test::SimRequest request{rigFile, "plane"};
+  const smx::eval::SimRequest request{rigFile, "plane"};
   const auto started = Clock::now();
-  c->frame = smx::test::renderSimFrame(benchRig(rigFile, scaled, keep),
-                                       smx::test::loadNamedScene("plane"), request);
+  c->frame = smx::eval::renderSimFrame(benchRig(rigFile, scaled, keep),
+                                       smx::eval::loadNamedScene("plane"), request);
   const double renderS = std::chrono::duration<double>(Clock::now() - started).count();
   const int w = c->frame.image.width;
   const int h = c->frame.image.height;

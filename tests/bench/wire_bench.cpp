@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "sim_frame.hpp"
 #include "smx/algo/camera_pipeline.hpp"
+#include "smx/eval/sim_frame.hpp"
 #include "smx/protocol/messages.hpp"
 
 namespace {
@@ -29,7 +29,7 @@ const SceneDepth& sceneDepth(const std::string& scene, const std::string& rigFil
   if (!added) {
     return it->second;
   }
-  const test::SimFrame frame = test::renderSimFrame({.rigFile = rigFile, .scene = scene});
+  const eval::SimFrame frame = eval::renderSimFrame({.rigFile = rigFile, .scene = scene});
   const auto setup = algo::prepareCameraPipeline(frame.rig, 0).value();
   std::vector<std::byte> memory(algo::CameraPipeline::workspaceBytes(setup).value());
   algo::Arena arena(memory);

@@ -4,11 +4,12 @@
 #include <string>
 
 #include "smx/algo/encoding_prediction.hpp"
+#include "smx/eval/frame_eval.hpp"
 
 namespace smx::test {
 
-std::unique_ptr<DemuxedFrame> demultiplex(const SimFrame& frame, const algo::DemuxParams& params,
-                                          double nominalDepthM) {
+std::unique_ptr<DemuxedFrame> demultiplex(const eval::SimFrame& frame,
+                                          const algo::DemuxParams& params, double nominalDepthM) {
   auto out = std::make_unique<DemuxedFrame>();
   const algo::DemuxLayout layout{frame.image.width, frame.image.height,
                                  static_cast<int>(frame.rig.projectors.size()), params};
@@ -33,20 +34,9 @@ std::unique_ptr<DemuxedFrame> demultiplex(const SimFrame& frame, const algo::Dem
   return out;
 }
 
-Mask regionLitBy(const SimFrame& frame, int projector, int patterns) {
-  std::vector<algo::ImageView<const std::uint8_t>> lits;
-  lits.reserve(frame.lit.size());
-  for (const auto& lit : frame.lit) {
-    lits.push_back(lit.view());
-  }
-  Mask region = smoothOnly(erode(litByExactly(lits, patterns), 3), frame.depth.view(), 0.02);
-  const auto& mine = frame.lit.at(static_cast<std::size_t>(projector));
-  for (int y = 0; y < region.height; ++y) {
-    for (int x = 0; x < region.width; ++x) {
-      region.at(x, y) = (region.at(x, y) != 0 && mine.at(x, y) != 0) ? 255 : 0;
-    }
-  }
-  return region;
+eval::Mask regionLitBy(const eval::SimFrame& frame, int projector, int patterns) {
+  return eval::litRegion(
+      frame, {.patterns = patterns, .exactly = true, .smooth = true, .projector = projector});
 }
 
 }  // namespace smx::test

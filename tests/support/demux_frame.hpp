@@ -4,10 +4,10 @@
 #include <memory>
 #include <vector>
 
-#include "boundary_eval.hpp"
-#include "sim_frame.hpp"
 #include "smx/algo/arena.hpp"
 #include "smx/algo/demux.hpp"
+#include "smx/eval/boundary_eval.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 // Test support: a rendered frame through orientation demultiplexing, and the regions the
 // accuracy tests score in.
@@ -24,12 +24,12 @@ struct DemuxedFrame {
 };
 
 // Runs camera 0 of the frame's rig; throws std::runtime_error naming the step that failed.
-[[nodiscard]] std::unique_ptr<DemuxedFrame> demultiplex(const SimFrame& frame,
+[[nodiscard]] std::unique_ptr<DemuxedFrame> demultiplex(const eval::SimFrame& frame,
                                                         const algo::DemuxParams& params = {},
                                                         double nominalDepthM = kTestNominalDepthM);
 
 // Pixels lit by exactly `patterns` projectors, projector among them, 3 px inside that region and
 // away from depth jumps over 2 %.
-[[nodiscard]] Mask regionLitBy(const SimFrame& frame, int projector, int patterns);
+[[nodiscard]] eval::Mask regionLitBy(const eval::SimFrame& frame, int projector, int patterns);
 
 }  // namespace smx::test

@@ -1,4 +1,4 @@
-#include "boundary_eval.hpp"
+#include "smx/eval/boundary_eval.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include "smx/algo/image_view.hpp"
 #include "smx/algo/stripe_code.hpp"
 
-namespace smx::test {
+namespace smx::eval {
 namespace {
 
 using algo::Boundary;
@@ -751,4 +751,4 @@ TEST(BoundaryEvalRegion, SmoothOnlyRemovesOcclusionEdgesAndMissingDepth) {
 }
 
 }  // namespace
-}  // namespace smx::test
+}  // namespace smx::eval

@@ -15,89 +15,28 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
-#include "boundary_eval.hpp"
 #include "demux_frame.hpp"
-#include "depth_eval.hpp"
-#include "sim_frame.hpp"
 #include "smx/algo/camera_pipeline.hpp"
+#include "smx/eval/boundary_eval.hpp"
+#include "smx/eval/depth_eval.hpp"
+#include "smx/eval/frame_eval.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 namespace smx::algo {
 namespace {
 
-struct Pipeline {
-  std::vector<std::byte> memory;
-  std::unique_ptr<Arena> arena;
-  std::unique_ptr<CameraPipeline> pipeline;
-};
-
-std::unique_ptr<Pipeline> runPipeline(const test::SimFrame& f, int camera,
-                                      const DecodeParams& decode = {}) {
-  PipelineOptions options;
-  options.nominalDepthM = test::kTestNominalDepthM;
+std::unique_ptr<eval::PipelineRun> runCounted(const eval::SimFrame& f, int camera,
+                                              const DecodeParams& decode = {}) {
+  PipelineOptions options = eval::evalPipelineOptions();
   options.decode = decode;
-  const auto setup = prepareCameraPipeline(f.rig, camera, options);
-  EXPECT_TRUE(setup) << (setup ? "" : setup.error());
-  auto p = std::make_unique<Pipeline>();
-  p->memory.resize(*CameraPipeline::workspaceBytes(*setup));
-  p->arena = std::make_unique<Arena>(p->memory);
-  auto pipeline = CameraPipeline::create(*setup, *p->arena);
-  EXPECT_TRUE(pipeline);
-  p->pipeline = std::make_unique<CameraPipeline>(std::move(*pipeline));
+  auto p = eval::makePipeline(f.rig, camera, options);
   const test::AllocationCounter counter;
   EXPECT_TRUE(p->pipeline->run(f.image.view()));
   EXPECT_EQ(counter.allocations(), 0U) << "the per-frame pipeline touched the heap";
   return p;
 }
 
-std::vector<ImageView<const std::uint8_t>> litViews(const test::SimFrame& f) {
-  std::vector<ImageView<const std::uint8_t>> lits;
-  for (const auto& lit : f.lit) {
-    lits.push_back(lit.view());
-  }
-  return lits;
-}
-
-// Pixels lit by at least / exactly n projectors (restricted to projector p's when p ≥ 0),
-// optionally 3 px inside and away from depth jumps over 2 % ("smooth").
-test::Mask region(const test::SimFrame& f, int n, bool exactly, bool smooth, int p = -1) {
-  const auto lits = litViews(f);
-  test::Mask m = exactly ? test::litByExactly(lits, n) : test::litByAtLeast(lits, n);
-  if (smooth) {
-    m = test::smoothOnly(test::erode(m, 3), f.depth.view(), 0.02);
-  }
-  if (p >= 0) {
-    for (int y = 0; y < m.height; ++y) {
-      for (int x = 0; x < m.width; ++x) {
-        m.at(x, y) =
-            (m.at(x, y) != 0 && f.lit[static_cast<std::size_t>(p)].at(x, y) != 0) ? 255 : 0;
-      }
-    }
-  }
-  return m;
-}
-
-// Completeness over the surface the camera sees lit: every lit pixel, no erosion.
-test::DepthScore scoreMerged(const test::SimFrame& f, int camera, const CameraPipeline& c,
-                             const test::Mask& m) {
-  test::DepthScoreOptions o;
-  o.fxPx = f.rig.cameras[static_cast<std::size_t>(camera)].fx();
-  double baseline = 0;
-  for (int p = 0; p < c.projectors(); ++p) {
-    baseline += baselineM(f.rig, camera, p) / c.projectors();
-  }
-  o.baselineM = baseline;  // the mean of the pairs' baselines
-  return test::scoreDepth(c.merged(), f.depth.view(), m.view(), o);
-}
-
-test::DepthScore scorePair(const test::SimFrame& f, int camera, const CameraPipeline& c, int p,
-                           const test::Mask& m) {
-  test::DepthScoreOptions o;
-  o.fxPx = f.rig.cameras[static_cast<std::size_t>(camera)].fx();
-  o.baselineM = baselineM(f.rig, camera, p);
-  return test::scoreDepth(c.depth(p), f.depth.view(), m.view(), o);
-}
-
-void print(const std::string& what, const test::DepthScore& s) {
+void print(const std::string& what, const eval::DepthScore& s) {
   std::printf(
       "%-34s %7d px | completeness %.4f | gross %.5f (%d) | rmse %.3f mm, %.4f px | mean %+.3f mm "
       "| phantom %d, outside %d (gross %d)\n",
@@ -105,23 +44,12 @@ void print(const std::string& what, const test::DepthScore& s) {
       s.rmsDisparityPx, s.meanErrorMm, s.phantom, s.validOutside, s.grossOutside);
 }
 
-struct SceneFigures {
-  test::DepthScore mergedAll;           // lit by ≥ 1, every pixel
-  test::DepthScore mergedSmooth;        // lit by ≥ 1, smooth interior
-  test::DepthScore merged2;             // lit by exactly 2, smooth interior
-  test::DepthScore merged3;             // lit by exactly 3, smooth interior
-  std::vector<test::DepthScore> pairs;  // each projector where it lights the surface, smooth
-};
+using SceneFigures = eval::FrameFigures;
 
-SceneFigures measure(const test::SimFrame& f, const std::string& label, int camera = 0,
+SceneFigures measure(const eval::SimFrame& f, const std::string& label, int camera = 0,
                      const DecodeParams& decode = {}) {
-  const auto p = runPipeline(f, camera, decode);
-  const CameraPipeline& c = *p->pipeline;
-  SceneFigures fig;
-  fig.mergedAll = scoreMerged(f, camera, c, region(f, 1, false, false));
-  fig.mergedSmooth = scoreMerged(f, camera, c, region(f, 1, false, true));
-  fig.merged2 = scoreMerged(f, camera, c, region(f, 2, true, true));
-  fig.merged3 = scoreMerged(f, camera, c, region(f, 3, true, true));
+  const auto p = runCounted(f, camera, decode);
+  const SceneFigures fig = eval::measureFrame(f, camera, *p->pipeline);
   print(label + " merged, lit by >= 1", fig.mergedAll);
   print(label + " merged, lit by >= 1, smooth", fig.mergedSmooth);
   if (fig.merged2.regionPixels > 0) {
@@ -130,9 +58,8 @@ SceneFigures measure(const test::SimFrame& f, const std::string& label, int came
   if (fig.merged3.regionPixels > 0) {
     print(label + " merged, lit by 3, smooth", fig.merged3);
   }
-  for (int q = 0; q < c.projectors(); ++q) {
-    fig.pairs.push_back(scorePair(f, camera, c, q, region(f, 1, false, true, q)));
-    print(label + " proj" + std::to_string(q) + " alone, smooth", fig.pairs.back());
+  for (std::size_t q = 0; q < fig.pairs.size(); ++q) {
+    print(label + " proj" + std::to_string(q) + " alone, smooth", fig.pairs[q]);
   }
   return fig;
 }
@@ -177,7 +104,7 @@ constexpr Bounds kTargets{0.95, 0.90, 0.80, 0.001, 0.1};
 constexpr Bounds kBoard{0.98, 0.98, 0.98, kTargets.grossRate / 2, 0.16};
 
 TEST(DecodeAccuracy, PlaneTwoPatterns90Deg) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "plane"});
   expectWithin(measure(f, "plane 2 x 90deg"), kBoard, "plane 90deg");
 }
 
@@ -187,23 +114,23 @@ TEST(DecodeAccuracy, PlaneTwoPatterns90Deg) {
 // larger depth error: 0.46 px of equivalent disparity per pair, 0.32 px merged (ratchet 0.35).
 TEST(DecodeAccuracy, PlaneSecondCamera) {
   const auto f =
-      test::renderSimFrame({.rigFile = "rig_2proj_2cam.json", .scene = "plane", .camera = 1});
+      eval::renderSimFrame({.rigFile = "rig_2proj_2cam.json", .scene = "plane", .camera = 1});
   Bounds bounds = kBoard;
   bounds.rmsDisparityPx = 0.35;
   expectWithin(measure(f, "plane cam1 of 2", 1), bounds, "plane cam1");
 }
 
 TEST(DecodeAccuracy, PlaneTwoPatterns70Deg) {
-  auto rig = test::loadExampleRig("rig_2proj_1cam.json");
+  auto rig = eval::loadExampleRig("rig_2proj_1cam.json");
   rig.projectors[1].pattern.angleDeg = 70.0;
-  const auto f = test::renderSimFrame(rig, test::loadNamedScene("plane"));
+  const auto f = eval::renderSimFrame(rig, eval::loadNamedScene("plane"));
   Bounds bounds = kBoard;
   bounds.rmsDisparityPx = 0.105;
   expectWithin(measure(f, "plane 2 x 70deg"), bounds, "plane 70deg");
 }
 
 TEST(DecodeAccuracy, PlaneThreePatterns60Deg) {
-  const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
+  const auto f = eval::renderSimFrame({"rig_3proj_1cam.json", "plane"});
   Bounds bounds = kBoard;
   bounds.rmsDisparityPx = kTargets.rmsDisparityPx;
   expectWithin(measure(f, "plane 3 x 60deg"), bounds, "plane 3 patterns");
@@ -215,27 +142,27 @@ TEST(DecodeAccuracy, PlaneThreePatterns60Deg) {
 // smooth completeness is 89 %: where one projector meets a dark surface colour its pattern is
 // lost (ratchet 0.87).
 TEST(DecodeAccuracy, Sphere) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
   expectWithin(measure(f, "sphere"), {0.96, 0.96, 0, 0.0032, 0.2}, "sphere");
 }
 
 TEST(DecodeAccuracy, RgbcmyPanel) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
   expectWithin(measure(f, "rgbcmy panel"), {0.865, 0.97, 0, 0.0025, 0.2}, "rgbcmy panel");
 }
 
 TEST(DecodeAccuracy, CupsWithOcclusion) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "cups"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "cups"});
   expectWithin(measure(f, "cups"), {0.94, 0.95, 0, 0.003, 0.2}, "cups");
 }
 
 TEST(DecodeAccuracy, Bunny) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "bunny"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "bunny"});
   expectWithin(measure(f, "bunny"), {0.94, 0.96, 0, 0.0038, 0.2}, "bunny");
 }
 
 TEST(DecodeAccuracy, StatueThreePatterns) {
-  const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "statue"});
+  const auto f = eval::renderSimFrame({"rig_3proj_1cam.json", "statue"});
   expectWithin(measure(f, "statue 3 patterns"), {0.93, 0.96, 0.93, 0.003, 0.2}, "statue");
 }
 
@@ -248,7 +175,7 @@ TEST(DecodeAccuracy, CurvesBeatScanLines) {
   lines.minCurveVotes = 1;
   for (const auto& [rigFile, scene] :
        {std::pair{"rig_3proj_1cam.json", "plane"}, std::pair{"rig_2proj_1cam.json", "sphere"}}) {
-    const auto f = test::renderSimFrame({rigFile, scene});
+    const auto f = eval::renderSimFrame({rigFile, scene});
     const std::string label = std::string(scene) + (f.rig.projectors.size() == 3 ? " 3p" : "");
     const SceneFigures byLine = measure(f, label + " scan lines", 0, lines);
     const SceneFigures byCurve = measure(f, label + " curves", 0);
@@ -264,25 +191,25 @@ TEST(DecodeAccuracy, CurvesBeatScanLines) {
 // amount = valid pixels / those of one projector. The paper's model for 1P1C, 2P1C, 3P1C has
 // relative amounts 28 %, 54 %, 79 % of a full scan, i.e. 1 : 1.9 : 2.8.
 TEST(DecodeAccuracy, MoreProjectorsSeeMoreOfTheObject) {
-  const auto full = test::loadExampleRig("rig_3proj_1cam.json");
-  const auto scene = test::loadNamedScene("statue");
+  const auto full = eval::loadExampleRig("rig_3proj_1cam.json");
+  const auto scene = eval::loadNamedScene("statue");
   std::vector<double> completeness;
   std::vector<int> valid;
   for (std::size_t n = 1; n <= 3; ++n) {
     auto rig = full;
     rig.projectors.resize(n);
-    const auto f = test::renderSimFrame(rig, scene);
-    const auto p = runPipeline(f, 0);
+    const auto f = eval::renderSimFrame(rig, scene);
+    const auto p = runCounted(f, 0);
     // The statue: pixels nearer than the wall behind it (the scene's background plane).
-    test::Mask object = test::Mask::filled(f.depth.width, f.depth.height, 0);
+    eval::Mask object = eval::Mask::filled(f.depth.width, f.depth.height, 0);
     for (int y = 0; y < object.height; ++y) {
       for (int x = 0; x < object.width; ++x) {
         object.at(x, y) =
             std::isfinite(f.depth.at(x, y)) && f.depth.at(x, y) < kStatueBehindM ? 255 : 0;
       }
     }
-    const test::DepthScore s =
-        test::scoreDepth(p->pipeline->merged(), f.depth.view(), object.view());
+    const eval::DepthScore s =
+        eval::scoreDepth(p->pipeline->merged(), f.depth.view(), object.view());
     completeness.push_back(s.completeness);
     valid.push_back(s.valid - s.gross);
     std::printf(

@@ -15,27 +15,27 @@
 #include <string>
 #include <vector>
 
-#include "boundary_eval.hpp"
 #include "demux_frame.hpp"
-#include "sim_frame.hpp"
 #include "smx/algo/demux.hpp"
+#include "smx/eval/boundary_eval.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 namespace smx::algo {
 namespace {
 
 struct Figures {
-  test::BoundaryScore boundaries;
-  test::AngleStats directions;
+  eval::BoundaryScore boundaries;
+  eval::AngleStats directions;
 };
 
 // Projector p's figures where exactly `patterns` projectors light the surface, p among them,
 // 3 px inside that region and away from depth jumps over 2 %.
-Figures measure(const test::SimFrame& f, const Demultiplexer& d, int p, int patterns,
+Figures measure(const eval::SimFrame& f, const Demultiplexer& d, int p, int patterns,
                 const std::string& label) {
-  const test::Mask region = test::regionLitBy(f, p, patterns);
-  Figures fig{test::scoreBoundaries(d.boundaries(p), d.directions(p),
+  const eval::Mask region = test::regionLitBy(f, p, patterns);
+  Figures fig{eval::scoreBoundaries(d.boundaries(p), d.directions(p),
                                     f.stripe[static_cast<std::size_t>(p)].view(), region.view()),
-              test::scoreDirections(d.directions(p), f.stripe[static_cast<std::size_t>(p)].view(),
+              eval::scoreDirections(d.directions(p), f.stripe[static_cast<std::size_t>(p)].view(),
                                     region.view())};
   const auto& b = fig.boundaries;
   std::printf(
@@ -70,7 +70,7 @@ constexpr Limits kTwoPatternTargets{2.0, 5.0, 0.98, 0.98, 0.99, 0.15};
 
 // Given the flat board and two patterns 90° apart, every target holds for both projectors.
 TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "plane"});
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 90deg"), kTwoPatternTargets,
@@ -80,9 +80,9 @@ TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
 
 // The same with the second pattern turned to 70° from the first.
 TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
-  auto rig = test::loadExampleRig("rig_2proj_1cam.json");
+  auto rig = eval::loadExampleRig("rig_2proj_1cam.json");
   rig.projectors[1].pattern.angleDeg = 70.0;
-  const auto f = test::renderSimFrame(rig, test::loadNamedScene("plane"));
+  const auto f = eval::renderSimFrame(rig, eval::loadNamedScene("plane"));
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 70deg"), kTwoPatternTargets,
@@ -95,7 +95,7 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 // is guessed from the tiles around, so the 95th percentile is far off target (ratchet: 15°);
 // boundaries are within a point of the targets (ratchet).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"),
@@ -108,7 +108,7 @@ TEST(DemuxAccuracy, TwoPatternsOnASphere) {
 // Three patterns 60° apart on the board: directions, recall, precision and class meet the
 // targets; the position error of one projector does not yet (ratchet: RMS 0.16 px).
 TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
-  const auto f = test::renderSimFrame({"rig_3proj_1cam.json", "plane"});
+  const auto f = eval::renderSimFrame({"rig_3proj_1cam.json", "plane"});
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 3; ++p) {
     expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"), {2.0, 5.0, 0.98, 0.99, 0.99, 0.16},
@@ -120,7 +120,7 @@ TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
 // Directions, recall, precision and class accuracy meet the targets (97 % class on the panel);
 // the position error at the colour edges does not yet (ratchet 0.21 px).
 TEST(DemuxAccuracy, TwoPatternsOnTheRgbcmyPanel) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "rgbcmy panel 90deg"),

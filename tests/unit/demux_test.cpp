@@ -96,6 +96,38 @@ TEST(Demux, RunRejectsAnImageOfAnotherSize) {
   EXPECT_EQ(ok.error().code, Errc::kSizeMismatch);
 }
 
+// Given tile directions fixed from outside (stripemux eval's true-directions baseline), when a
+// frame runs, then the direction stage keeps them instead of estimating its own (which would
+// find both patterns at their true angles), without heap use; a wrong count is refused.
+TEST(Demux, FixedTileDirectionsReplaceTheEstimate) {
+  const std::vector<SyntheticPattern> patterns{{0.0, 6.0}, {90.0, 6.0}};
+  constexpr int kW = 96;
+  constexpr int kH = 64;
+  const auto image = superpose(patterns, kW, kH);
+  const DemuxLayout layout{kW, kH, 2, {}};
+  std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
+  Arena arena(memory);
+  auto demux = Demultiplexer::create(layout, exactPrediction(layout, patterns), arena);
+  ASSERT_TRUE(demux.has_value());
+  const std::vector<TileDirection> tooFew(layout.tileCount(), TileDirection{});
+  EXPECT_EQ(demux->fixTileDirections(tooFew).error().code, Errc::kSizeMismatch);
+
+  // Projector 0 absent everywhere, projector 1 present at 45°: not what the image holds.
+  std::vector<TileDirection> fixed(layout.tileCount() * 2, TileDirection{});
+  for (std::size_t t = 0; t < layout.tileCount(); ++t) {
+    fixed[layout.tileCount() + t] = {BinAngle::fromDegrees(45.0).raw, 1};
+  }
+  ASSERT_TRUE(demux->fixTileDirections(fixed).has_value());
+  const test::AllocationCounter counter;
+  ASSERT_TRUE(demux->run(*ConstRgbView::packed(image, kW, kH)).has_value());
+  EXPECT_EQ(counter.allocations(), 0U);
+  for (std::size_t t = 0; t < layout.tileCount(); ++t) {
+    EXPECT_EQ(demux->tileDirections(0)[t].present, 0) << "tile " << t;
+    EXPECT_EQ(demux->tileDirections(1)[t].present, 1) << "tile " << t;
+    EXPECT_EQ(demux->tileDirections(1)[t].angle, BinAngle::fromDegrees(45.0).raw) << "tile " << t;
+  }
+}
+
 // Given two clean patterns 90° apart (and, separately, 70° apart), when a frame runs, then each
 // projector's boundaries lie where its stripe coordinate crosses an integer, with the class of
 // the colours on either side, and the frame touched the heap not once.

@@ -1,5 +1,5 @@
 // Depth scoring on hand-worked planes: every expected number is worked out in the comments.
-#include "depth_eval.hpp"
+#include "smx/eval/depth_eval.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace smx::test {
+namespace smx::eval {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -94,4 +94,4 @@ TEST(DepthEval, EmptyRegionGivesZerosAndSizeMismatchThrows) {
 }
 
 }  // namespace
-}  // namespace smx::test
+}  // namespace smx::eval

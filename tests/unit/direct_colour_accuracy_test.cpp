@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "boundary_eval.hpp"
 #include "demux_frame.hpp"
-#include "sim_frame.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/direct_colour.hpp"
+#include "smx/eval/boundary_eval.hpp"
+#include "smx/eval/sim_frame.hpp"
 #include "smx/sim/renderer.hpp"
 
 namespace smx::algo {
@@ -29,8 +29,8 @@ namespace {
 
 struct Comparison {
   int regionPx = 0;
-  test::BoundaryScore baseline;
-  test::BoundaryScore demux;
+  eval::BoundaryScore baseline;
+  eval::BoundaryScore demux;
   // Detections with the true class, the baseline's per the demultiplexer's: both are scored on
   // the same truth, so this is how much of what the demultiplexer delivers the baseline does.
   [[nodiscard]] double rightClassRatio() const {
@@ -40,17 +40,17 @@ struct Comparison {
 };
 
 // Projector p's boundaries by both methods, scored in one region.
-Comparison compare(const test::SimFrame& f, const Demultiplexer& d, int p, int patterns,
+Comparison compare(const eval::SimFrame& f, const Demultiplexer& d, int p, int patterns,
                    const std::string& label) {
-  const test::Mask region = test::regionLitBy(f, p, patterns);
-  test::OwnedPlane<Boundary> baseline(f.image.width, f.image.height, Boundary{});
+  const eval::Mask region = test::regionLitBy(f, p, patterns);
+  eval::OwnedPlane<Boundary> baseline(f.image.width, f.image.height, Boundary{});
   const auto ok = directColourBoundaries(f.image.view(), d.directions(p), baseline.view());
   EXPECT_TRUE(ok.has_value()) << ok.error().message;
   const auto& stripe = f.stripe[static_cast<std::size_t>(p)];
   Comparison c{
       region.count(),
-      test::scoreBoundaries(baseline.view(), d.directions(p), stripe.view(), region.view()),
-      test::scoreBoundaries(d.boundaries(p), d.directions(p), stripe.view(), region.view())};
+      eval::scoreBoundaries(baseline.view(), d.directions(p), stripe.view(), region.view()),
+      eval::scoreBoundaries(d.boundaries(p), d.directions(p), stripe.view(), region.view())};
   const auto& b = c.baseline;
   const auto& m = c.demux;
   std::printf(
@@ -78,9 +78,9 @@ struct PixelReading {
   double clearReadsDimmer = 0;
 };
 
-test::OwnedPlane<Rgb8> renderAlone(const test::SimFrame& f, const std::string& scene, int p) {
-  test::OwnedPlane<Rgb8> image(f.image.width, f.image.height, Rgb8{0, 0, 0});
-  auto renderer = sim::Renderer::create(f.rig, test::loadNamedScene(scene));
+eval::OwnedPlane<Rgb8> renderAlone(const eval::SimFrame& f, const std::string& scene, int p) {
+  eval::OwnedPlane<Rgb8> image(f.image.width, f.image.height, Rgb8{0, 0, 0});
+  auto renderer = sim::Renderer::create(f.rig, eval::loadNamedScene(scene));
   EXPECT_TRUE(renderer.has_value());
   if (renderer.has_value()) {
     std::vector<bool> lit(f.rig.projectors.size(), false);
@@ -94,15 +94,15 @@ std::uint8_t channelOf(Rgb8 c, stripe::Colour colour) {
   return colour == stripe::Colour::kRed ? c.r : (colour == stripe::Colour::kGreen ? c.g : c.b);
 }
 
-PixelReading readPixels(const test::SimFrame& f, const std::string& scene) {
-  const test::OwnedPlane<Rgb8> alone[2] = {renderAlone(f, scene, 0), renderAlone(f, scene, 1)};
+PixelReading readPixels(const eval::SimFrame& f, const std::string& scene) {
+  const eval::OwnedPlane<Rgb8> alone[2] = {renderAlone(f, scene, 0), renderAlone(f, scene, 1)};
   std::vector<ImageView<const std::uint8_t>> lits;
   lits.reserve(f.lit.size());
   for (const auto& lit : f.lit) {
     lits.push_back(lit.view());
   }
-  const test::Mask region =
-      test::smoothOnly(test::erode(test::litByExactly(lits, 2), 3), f.depth.view(), 0.02);
+  const eval::Mask region =
+      eval::smoothOnly(eval::erode(eval::litByExactly(lits, 2), 3), f.depth.view(), 0.02);
   int reads[3] = {0, 0, 0};
   int clearReads[2] = {0, 0};  // brighter, dimmer
   PixelReading r;
@@ -191,7 +191,7 @@ void expectNeitherProjectorIsRead(const PixelReading& r, double minEitherShare,
 }
 
 TEST(DirectColourAccuracy, OnAPlaneItFailsWhereTwoPatternsOverlap) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "plane"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "plane"});
   const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "plane"), 0.9, "plane");
   for (int p = 0; p < 2; ++p) {
@@ -203,7 +203,7 @@ TEST(DirectColourAccuracy, OnAPlaneItFailsWhereTwoPatternsOverlap) {
 }
 
 TEST(DirectColourAccuracy, OnASphereItWorksAloneAndFailsWhereTwoPatternsOverlap) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
   const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "sphere"), 0.9, "sphere");
   for (int p = 0; p < 2; ++p) {
@@ -216,7 +216,7 @@ TEST(DirectColourAccuracy, OnASphereItWorksAloneAndFailsWhereTwoPatternsOverlap)
 // The panel's strong colours add a second failure: under some stripe colours a patch is too
 // dark or too unsaturated to classify at all (the lit-by-1 control lies on the grey wall).
 TEST(DirectColourAccuracy, OnTheRgbcmyPanelItFailsWhereTwoPatternsOverlap) {
-  const auto f = test::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
+  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
   const auto d = test::demultiplex(f);
   expectNeitherProjectorIsRead(readPixels(f, "rgbcmy_panel"), 0.75, "rgbcmy_panel");
   for (int p = 0; p < 2; ++p) {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "sim_frame.hpp"
 #include "smx/algo/triangulation.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 namespace smx::algo {
 namespace {
@@ -20,7 +20,7 @@ struct Errors {
   double maxUnits = 0;
 };
 
-Errors triangulateTruth(const test::SimFrame& f, int camera, int projector) {
+Errors triangulateTruth(const eval::SimFrame& f, int camera, int projector) {
   const auto tables = buildTriangulationTables(f.rig, camera, projector, kDefaultDepthUnitM);
   EXPECT_TRUE(tables) << (tables ? "" : tables.error());
   const int w = f.image.width;
@@ -72,7 +72,7 @@ Errors triangulateTruth(const test::SimFrame& f, int camera, int projector) {
 TEST(TriangulationSim, TruthStripeGivesTruthDepth) {
   for (const char* scene : {"plane", "sphere"}) {
     for (int camera = 0; camera < 2; ++camera) {
-      const auto f = test::renderSimFrame(
+      const auto f = eval::renderSimFrame(
           {.rigFile = "rig_2proj_2cam.json", .scene = scene, .camera = camera});
       for (int p = 0; p < 2; ++p) {
         const Errors e = triangulateTruth(f, camera, p);

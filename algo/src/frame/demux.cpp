@@ -2,7 +2,9 @@
 // takes memory), the stages of demux_kernels.hpp run in order per frame.
 #include "smx/algo/demux.hpp"
 
+#include <algorithm>
 #include <cstdint>
+#include <span>
 
 #include "demux_kernels.hpp"
 #include "smx/algo/fixed_math.hpp"
@@ -134,9 +136,11 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::smoothChannels(image, smoothed_, p.smoothPasses, rowScratch_);
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
-  demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
-  demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
-                            tileScratch_);
+  if (!fixedDirections_) {
+    demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
+    demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                              tileScratch_);
+  }
   demux::interpolateDirections(
       layout_, tileDirections_, columns_, rows_,
       std::span<const DirectionPlane>(directions_.data(),
@@ -146,6 +150,16 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
       return ok;
     }
   }
+  return {};
+}
+
+Result<void> Demultiplexer::fixTileDirections(std::span<const TileDirection> tiles) {
+  if (tiles.size() != tileDirections_.size()) {
+    return fail(Errc::kSizeMismatch,
+                "demux: fixed tile directions need projectors x tiles entries");
+  }
+  std::ranges::copy(tiles, tileDirections_.begin());
+  fixedDirections_ = true;
   return {};
 }
 

@@ -93,6 +93,11 @@ class Demultiplexer {
   // tileCount() entries for the projector, row-major over tiles.
   [[nodiscard]] std::span<const TileDirection> tileDirections(int projector) const;
 
+  // Evaluation seam (stripemux eval's "true directions" baseline): from now on run() takes the
+  // tile directions from here instead of estimating them. projectors × tileCount entries,
+  // projector-major as tileDirections() reads them; copied, no allocation.
+  [[nodiscard]] Result<void> fixTileDirections(std::span<const TileDirection> tiles);
+
   // Debug view of the last projector separated by run() (or by separateOnly()): its
   // colour-normalised derivative per channel (Q4.11 of the local average colour).
   [[nodiscard]] ImageView<const std::int16_t> separated(int channel) const;
@@ -118,6 +123,7 @@ class Demultiplexer {
   std::span<std::uint32_t> tileInverseColour_;  // tileCount × 3: 2^24 / average
   std::span<std::uint16_t> tileScratch_;        // tileCount: the direction median filter's
   std::span<TileDirection> tileDirections_;     // projectors × tileCount
+  bool fixedDirections_ = false;                // fixTileDirections() was called
   std::array<ImageView<std::int16_t>, 3> smoothed_;
   std::array<ImageView<std::int16_t>, 3> separated_;
   ImageView<std::uint16_t> strength_;

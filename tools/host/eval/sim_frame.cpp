@@ -1,4 +1,4 @@
-#include "sim_frame.hpp"
+#include "smx/eval/sim_frame.hpp"
 
 #include <stdexcept>
 #include <utility>
@@ -7,7 +7,7 @@
 #include "smx/sim/renderer.hpp"
 #include "smx/sim/scene_json.hpp"
 
-namespace smx::test {
+namespace smx::eval {
 
 namespace {
 std::filesystem::path sourceDir() {
@@ -69,4 +69,4 @@ SimFrame renderSimFrame(algo::Rig rig, const sim::Scene& scene, const SimRequest
   return f;
 }
 
-}  // namespace smx::test
+}  // namespace smx::eval

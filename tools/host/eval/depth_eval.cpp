@@ -1,10 +1,10 @@
-#include "depth_eval.hpp"
+#include "smx/eval/depth_eval.hpp"
 
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-namespace smx::test {
+namespace smx::eval {
 
 namespace {
 
@@ -96,4 +96,4 @@ std::vector<float> depthErrorMapMm(algo::ConstDepthPlane depth,
   return map;
 }
 
-}  // namespace smx::test
+}  // namespace smx::eval

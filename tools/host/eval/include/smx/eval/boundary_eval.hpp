@@ -10,11 +10,11 @@
 #include "smx/algo/image_view.hpp"
 #include "smx/algo/stripe_code.hpp"
 
-// Test support: scores the stripe boundaries and encoding directions found by orientation
-// demultiplexing (algo::Boundary / algo::ConstDirectionPlane of one projector and camera) against
-// the simulator's exact ground truth for that projector (the `stripe` plane, docs/simulator.md).
-// Host/test code: double precision, allocates, throws std::invalid_argument on misuse (planes of
-// different sizes), so a misused helper fails the calling test with a message.
+// Evaluation (stripemux eval, accuracy tests): scores the stripe boundaries and encoding directions
+// found by orientation demultiplexing (algo::Boundary / algo::ConstDirectionPlane of one projector
+// and camera) against the simulator's exact ground truth for that projector (the `stripe` plane,
+// docs/simulator.md). Host code: double precision, allocates, throws std::invalid_argument on
+// misuse (planes of different sizes), so a misused helper fails the calling test with a message.
 //
 // Definitions (s = truth stripe plane, float, NaN where the projector does not light the point;
 // stripe k occupies s ∈ [k, k+1); image coordinates x right, y down, pixel (x, y) is the centre):
@@ -48,7 +48,7 @@
 //             matched to p's level / owners in the region.
 // Precision = matched / detected (in region).   Class accuracy = class correct / matched.
 // Ratios of empty sets are 1.0 and position statistics of an empty set are 0: check the counts.
-namespace smx::test {
+namespace smx::eval {
 
 inline constexpr double kMinStripesPerPx = 1e-4;  // |∇s| below this: direction undefined
 inline constexpr int kFirstLevel = 1;
@@ -150,4 +150,4 @@ struct AngleStats {
 [[nodiscard]] Mask smoothOnly(const Mask& mask, algo::ImageView<const float> depth,
                               double maxRelativeJump);
 
-}  // namespace smx::test
+}  // namespace smx::eval

@@ -1,4 +1,4 @@
-#include "boundary_eval.hpp"
+#include "smx/eval/boundary_eval.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace smx::test {
+namespace smx::eval {
 namespace {
 
 using algo::ImageView;
@@ -418,4 +418,4 @@ Mask smoothOnly(const Mask& mask, ImageView<const float> depth, double maxRelati
   return out;
 }
 
-}  // namespace smx::test
+}  // namespace smx::eval

@@ -6,9 +6,10 @@
 #include "smx/algo/image_view.hpp"
 #include "smx/algo/range_image.hpp"
 
-// Test support: scores a range image (uint16 z in the camera frame in depth units, 0 = no data)
-// against the simulator's truth depth (float z in metres, NaN where the ray hits nothing).
-// Host/test code, double precision; throws std::invalid_argument on planes of different sizes.
+// Evaluation (stripemux eval, accuracy tests): scores a range image (uint16 z in the camera frame
+// in depth units, 0 = no data) against the simulator's truth depth (float z in metres, NaN where
+// the ray hits nothing). Host code, double precision; throws std::invalid_argument on planes of
+// different sizes.
 //
 // Definitions (z = depth·unit, z_gt = truth, both metres):
 //   region pixels   pixels with region ≠ 0 and a finite z_gt;
@@ -21,7 +22,7 @@
 //   z_gt is finite and region = 0, grossOutside = those of them that are gross;
 //   validTotal = depth ≠ 0 anywhere.
 // Ratios of empty sets are 0 and statistics of an empty set are 0: check the counts.
-namespace smx::test {
+namespace smx::eval {
 
 inline constexpr double kGrossAbsoluteM = 0.005;
 inline constexpr double kGrossRelative = 0.01;
@@ -62,4 +63,4 @@ struct DepthScore {
                                                  algo::ImageView<const float> truthDepth,
                                                  double depthUnitM = algo::kDefaultDepthUnitM);
 
-}  // namespace smx::test
+}  // namespace smx::eval

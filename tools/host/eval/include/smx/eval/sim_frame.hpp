@@ -9,9 +9,9 @@
 #include "smx/algo/rig.hpp"
 #include "smx/sim/scene.hpp"
 
-// Test support: one rendered camera frame of a rig and a scene with the ground truth the
-// algorithm tests score against, in owning buffers.
-namespace smx::test {
+// Evaluation (stripemux eval, accuracy tests): one rendered camera frame of a rig and a scene,
+// with the simulator's ground truth, in owning buffers.
+namespace smx::eval {
 
 template <class T>
 struct OwnedPlane {
@@ -60,4 +60,4 @@ struct SimRequest {
 [[nodiscard]] sim::Scene loadNamedScene(const std::string& name);
 [[nodiscard]] algo::Rig loadExampleRig(const std::string& file);
 
-}  // namespace smx::test
+}  // namespace smx::eval

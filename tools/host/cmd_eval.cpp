@@ -1,0 +1,112 @@
+// stripemux eval [--out DIR] [--only SECTION,...] [--scene NAME ...] [--seed N]
+// The evaluation suite: the named scenes rendered by the simulator, decoded by the firmware's
+// pipeline and scored against the truth; writes DIR/results.md and DIR/results/*.png
+// (docs/results.md is this command's output with the defaults).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "eval_report.hpp"
+#include "smx/eval/suite.hpp"
+#include "smx/sim/named_scenes.hpp"
+
+namespace smx::host {
+namespace {
+
+struct EvalOptions {
+  std::filesystem::path out = "docs";
+  std::vector<std::string> only;
+  std::vector<std::string> scenes;
+  std::uint64_t seed = 1;
+};
+
+std::string commandLine(const EvalOptions& o) {
+  std::string c = "stripemux eval";
+  if (o.out != "docs") {
+    c += " --out " + o.out.string();
+  }
+  for (std::size_t i = 0; i < o.only.size(); ++i) {
+    c += (i == 0 ? " --only " : ",") + o.only[i];
+  }
+  for (const auto& s : o.scenes) {
+    c += " --scene " + s;
+  }
+  if (o.seed != 1) {
+    c += " --seed " + std::to_string(o.seed);
+  }
+  return c;
+}
+
+int runEval(const EvalOptions& o, const CliStreams& io) {
+  eval::SuiteOptions suite;
+  suite.seed = o.seed;
+  if (!o.only.empty()) {
+    suite.sections.clear();
+    for (const auto& name : o.only) {
+      bool found = false;
+      for (const auto s : eval::allSections()) {
+        if (name == eval::sectionName(s)) {
+          suite.sections.push_back(s);
+          found = true;
+        }
+      }
+      if (!found) {
+        io.err << "stripemux eval: unknown section '" << name
+               << "' (sections: scenes, flat, table2, baselines, sweeps)\n";
+        return kExitUsage;
+      }
+    }
+  }
+  const auto named = sim::namedScenes();
+  for (const auto& scene : o.scenes) {
+    if (std::ranges::find(named, scene) == named.end()) {
+      io.err << "stripemux eval: unknown scene '" << scene << "' (named scenes:";
+      for (const auto& n : named) {
+        io.err << ' ' << n;
+      }
+      io.err << ")\n";
+      return kExitUsage;
+    }
+  }
+  suite.scenes = o.scenes;
+  suite.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
+  eval::Report report;
+  try {
+    report = eval::runSuite(suite);
+  } catch (const std::exception& e) {
+    io.err << "stripemux eval: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  if (auto ok = writeEvalReport(o.out, report, commandLine(o)); !ok) {
+    io.err << "stripemux eval: " << ok.error() << '\n';
+    return kExitDeviceOrIo;
+  }
+  io.out << "wrote " << (o.out / "results.md").string() << " and " << (o.out / "results").string()
+         << "/ in " << std::lround(report.seconds) << " s\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto options = std::make_shared<EvalOptions>();
+  auto* cmd = app.add_subcommand(
+      "eval",
+      "Render the scene suite, decode it and score it against the truth: results.md + plots");
+  cmd->add_option("--out", options->out, "Folder for results.md and results/ (default docs)");
+  cmd->add_option("--only", options->only,
+                  "Sections to run: scenes, flat, table2, baselines, sweeps (default all)")
+      ->delimiter(',');
+  cmd->add_option("--scene", options->scenes,
+                  "Only the suite's runs of these named scenes (repeatable)");
+  cmd->add_option("--seed", options->seed, "Noise seed of the renders (default 1)");
+  cmd->callback([options, &io, &exitCode] { exitCode = runEval(*options, io); });
+}
+
+}  // namespace smx::host

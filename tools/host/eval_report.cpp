@@ -1,0 +1,403 @@
+#include "eval_report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <system_error>
+#include <vector>
+
+#include "smx/plots/plots.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fixed(double v, int decimals) {
+  if (!std::isfinite(v)) {
+    return "–";
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+std::string pct(double ratio, int decimals = 1) {
+  return std::isfinite(ratio) ? fixed(100.0 * ratio, decimals) + " %" : "–";
+}
+// A completeness over a region that the frame does not have is no figure.
+double ratioOrNaN(const eval::DepthScore& s, double ratio) {
+  return s.regionPixels > 0 ? ratio : kNaN;
+}
+std::string completeness(const eval::DepthScore& s) {
+  return pct(ratioOrNaN(s, s.completeness));
+}
+
+// A usable result: most of the smooth lit surface measured, few gross errors.
+constexpr double kUsableCompleteness = 0.90;
+constexpr double kUsableGross = 0.01;
+bool usable(const eval::FrameFigures& f) {
+  return f.mergedSmooth.completeness >= kUsableCompleteness &&
+         f.mergedAll.grossRate <= kUsableGross;
+}
+
+std::string slug(std::string s) {
+  for (char& c : s) {
+    if (std::isalnum(static_cast<unsigned char>(c)) == 0) {
+      c = '_';
+    }
+  }
+  return s;
+}
+
+struct Writer {
+  fs::path dir;
+  std::ostringstream md;
+  std::string error;
+
+  void plot(const std::expected<void, std::string>& written) {
+    if (!written && error.empty()) {
+      error = written.error();
+    }
+  }
+  [[nodiscard]] fs::path png(const std::string& name) const { return dir / "results" / name; }
+  void image(const std::string& alt, const std::string& name) {
+    md << "![" << alt << "](results/" << name << ")\n";
+  }
+
+  void scenes(const eval::Report& r) {
+    if (r.scenes.empty()) {
+      return;
+    }
+    md << "## Scenes\n\n"
+          "Each named scene rendered by the simulator (the paper's noise, seed "
+       << r.seed
+       << ") and decoded by the firmware's camera pipeline; the merged range image of all "
+          "projectors, scored against the truth depth.\n\n"
+          "| scene | rig | camera | completeness, all lit | smooth | lit by 2 | lit by 3 | gross "
+          "| RMSE mm | RMSE disparity px |\n"
+          "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& s : r.scenes) {
+      const auto& f = s.figures;
+      md << "| " << s.scene << " | " << s.rigFile << " | cam" << s.camera << " | "
+         << completeness(f.mergedAll) << " | " << completeness(f.mergedSmooth) << " | "
+         << completeness(f.merged2) << " | " << completeness(f.merged3) << " | "
+         << pct(f.mergedAll.grossRate, 2) << " | " << fixed(f.mergedAll.rmseMm, 2) << " | "
+         << fixed(f.mergedAll.rmsDisparityPx, 3) << " |\n";
+    }
+    md << "\n### Per projector–camera pair\n\n"
+          "Each projector's own range image where it lights the surface (smooth interior).\n\n"
+          "| scene | rig | pair | completeness | gross | RMSE mm | RMSE disparity px |\n"
+          "|---|---|---|---|---|---|---|\n";
+    for (const auto& s : r.scenes) {
+      for (std::size_t p = 0; p < s.figures.pairs.size(); ++p) {
+        const auto& d = s.figures.pairs[p];
+        md << "| " << s.scene << " | " << s.rigFile << " | proj" << p << "–cam" << s.camera << " | "
+           << completeness(d) << " | " << pct(d.grossRate, 2) << " | " << fixed(d.rmseMm, 2)
+           << " | " << fixed(d.rmsDisparityPx, 3) << " |\n";
+      }
+    }
+    plots::BarChart bars{"Completeness per scene (merged range image)",
+                         "completeness",
+                         0,
+                         1,
+                         {},
+                         {"all lit pixels", "lit by 2 (smooth)", "lit by 3 (smooth)"},
+                         {{}, {}, {}}};
+    md << "\n";
+    for (const auto& s : r.scenes) {
+      const std::string label = s.scene +
+                                (s.rigFile.find("3proj") != std::string::npos ? " 3p" : "") +
+                                (s.camera > 0 || s.rigFile.find("2cam") != std::string::npos
+                                     ? " c" + std::to_string(s.camera)
+                                     : "");
+      bars.categories.push_back(label);
+      bars.values[0].push_back(s.figures.mergedAll.completeness);
+      bars.values[1].push_back(ratioOrNaN(s.figures.merged2, s.figures.merged2.completeness));
+      bars.values[2].push_back(ratioOrNaN(s.figures.merged3, s.figures.merged3.completeness));
+    }
+    plot(plots::writeBarChart(png("completeness.png"), bars));
+    image("completeness per scene", "completeness.png");
+    md << "\n### Depth error maps\n\n"
+          "Merged depth − truth, ±2 mm full scale (blue nearer, red farther); grey: no depth.\n\n";
+    for (const auto& s : r.scenes) {
+      const std::string name = "error_" + slug(s.scene) + "_" + slug(s.rigFile) + "_cam" +
+                               std::to_string(s.camera) + ".png";
+      plot(plots::writeErrorMap(png(name), s.errorMm, s.width, s.height, 2.0,
+                                s.scene + ", " + s.rigFile + ", cam" + std::to_string(s.camera)));
+      image(s.scene + " error map", name);
+    }
+    md << "\n";
+  }
+
+  void flat(const eval::Report& r) {
+    if (r.flat.empty() && r.distance.empty()) {
+      return;
+    }
+    md << "## Flat targets\n\n"
+          "The figures a depth-camera quality tool reports on a wall: fill rate (pixels with "
+          "depth / pixels of the smooth lit target) and the RMS distance of the points to their "
+          "least-squares plane (spatial noise), with the RMSE against the truth beside it. The "
+          "target is the smooth lit surface at the image centre (truth depth within 2 cm of "
+          "the centre's).\n\n"
+          "| target | distance m | fill rate | plane-fit RMS mm | RMSE mm | RMSE disparity px |"
+          " gross |\n|---|---|---|---|---|---|---|\n";
+    auto row = [&](const eval::FlatRun& f) {
+      md << "| " << f.target << " | " << fixed(f.distanceM, 2) << " | " << pct(f.fit.fillRate, 2)
+         << " | " << fixed(f.fit.rmsMm, 3) << " | " << fixed(f.score.rmseMm, 3) << " | "
+         << fixed(f.score.rmsDisparityPx, 3) << " | " << pct(f.score.grossRate, 2) << " |\n";
+    };
+    for (const auto& f : r.flat) {
+      row(f);
+    }
+    for (const auto& f : r.distance) {
+      row(f);
+    }
+    if (!r.distance.empty()) {
+      plots::LineChart chart{"Error vs distance (plane, 2 patterns at 90 deg)",
+                             "distance, m",
+                             "mm",
+                             {{"plane-fit RMS", {}, {}}, {"RMSE vs truth", {}, {}}},
+                             true,
+                             {},
+                             {}};
+      for (const auto& f : r.distance) {
+        chart.series[0].x.push_back(f.distanceM);
+        chart.series[0].y.push_back(f.fit.rmsMm);
+        chart.series[1].x.push_back(f.distanceM);
+        chart.series[1].y.push_back(f.score.rmseMm);
+      }
+      plot(plots::writeLineChart(png("error_vs_distance.png"), chart));
+      md << "\n";
+      image("error vs distance", "error_vs_distance.png");
+    }
+    md << "\n";
+  }
+
+  void table2(const eval::Report& r) {
+    if (r.table2.empty()) {
+      return;
+    }
+    md << "## The paper's Table 2, measured\n\n"
+          "A sphere (radius 15 cm) with stations at the corners of a regular tetrahedron around "
+          "it, 0.9 m out; station i holds camera i and projector i (`tools/host/eval/table2.hpp` "
+          "has the layout). nPmC uses the first n projectors and m cameras, all patterns on at "
+          "once. Relative amount: inlier pixels summed over every projector–camera pair, in the "
+          "paper's unit (one scan of the whole sphere = 100 %: the 1P1C amount is its "
+          "completeness). Completeness: the share of the sphere's surface on which some inlier "
+          "lands (equal-area bins of 1.5 cm²); \"geometric\" is the same from the truth, the "
+          "most any decoder could get in this layout.\n\n"
+          "| projectors | cameras | amount, measured | amount, paper | completeness, measured "
+          "| geometric | completeness, paper | gross |\n|---|---|---|---|---|---|---|---|\n";
+    plots::BarChart chart{"Table 2: relative completeness, measured vs the paper's model",
+                          "completeness",
+                          0,
+                          1,
+                          {},
+                          {"measured", "geometric bound", "paper (modelled)"},
+                          {{}, {}, {}}};
+    for (const auto& t : r.table2) {
+      md << "| " << t.projectors << " | " << t.cameras << " | " << pct(t.amountPaperUnit, 0)
+         << " | " << pct(t.paperAmount, 0) << " | " << pct(t.completeness, 0) << " | "
+         << pct(t.geometricCompleteness, 0) << " | " << pct(t.paperCompleteness, 0) << " | "
+         << pct(t.grossRate, 2) << " |\n";
+      chart.categories.push_back(std::to_string(t.projectors) + "P" + std::to_string(t.cameras) +
+                                 "C");
+      chart.values[0].push_back(t.completeness);
+      chart.values[1].push_back(t.geometricCompleteness);
+      chart.values[2].push_back(t.paperCompleteness);
+    }
+    plot(plots::writeBarChart(png("table2_completeness.png"), chart));
+    md << "\n";
+    image("Table 2 completeness", "table2_completeness.png");
+    md << "\nPairs that delivered depth (camera–projector: inlier pixels / pixels the projector "
+          "lights in that camera's view):\n\n";
+    for (const auto& t : r.table2) {
+      md << "- " << t.projectors << "P" << t.cameras << "C:";
+      for (const auto& p : t.pairs) {
+        md << " cam" << p.camera << "–proj" << p.projector << " " << p.inliers() << "/"
+           << p.litPixels << ";";
+      }
+      for (std::size_t c = 0; c < t.dropped.size(); ++c) {
+        for (const int p : t.dropped[c]) {
+          md << " (cam" << c << " does not decode proj" << p << ": 3 patterns per camera at most)";
+        }
+      }
+      md << "\n";
+    }
+    md << "\n";
+  }
+
+  void baselines(const eval::Report& r) {
+    if (r.singleProjector.empty() && r.directColour.empty() && r.trueDirections.empty()) {
+      return;
+    }
+    md << "## Baselines\n\n";
+    if (!r.singleProjector.empty()) {
+      md << "### One projector against several\n\n"
+            "A conventional single-projector scanner against the same rig with more "
+            "projectors, each rendered with only its projectors present: the share of "
+            "everything the camera sees (every pixel with a surface, lit or not) that gets "
+            "depth.\n\n"
+            "| scene | rig | projectors | coverage of the view | relative amount | gross | RMSE "
+            "disparity px |\n|---|---|---|---|---|---|---|\n";
+      std::map<std::string, int> single;
+      for (const auto& c : r.singleProjector) {
+        const int inliers = c.view.valid - c.view.gross;
+        if (c.projectors == 1) {
+          single[c.scene] = inliers;
+        }
+        const int base = single[c.scene];
+        md << "| " << c.scene << " | " << c.rigFile << " | " << c.projectors << " | "
+           << pct(c.view.completeness) << " | "
+           << (base > 0 ? fixed(static_cast<double>(inliers) / base, 2) : "–") << " | "
+           << pct(c.view.grossRate, 2) << " | " << fixed(c.view.rmsDisparityPx, 3) << " |\n";
+      }
+      md << "\n";
+    }
+    if (!r.directColour.empty()) {
+      md << "### Direct colour estimation against orientation demultiplexing\n\n"
+            "The single-projector decoder's front end (hue classification, "
+            "`algo/direct_colour.hpp`) on the superposed image, given the demultiplexer's own "
+            "directions, so only the colour decision differs. Boundaries of each projector "
+            "scored against the truth where exactly n patterns light the surface.\n\n"
+            "| scene | projector | lit by | demux recall | demux class accuracy | direct recall "
+            "| direct precision | direct class accuracy |\n|---|---|---|---|---|---|---|---|\n";
+      for (const auto& b : r.directColour) {
+        md << "| " << b.scene << " | proj" << b.projector << " | " << b.patterns << " | "
+           << pct(b.demux.recall) << " | " << pct(b.demux.classAccuracy) << " | "
+           << pct(b.other.recall) << " | " << pct(b.other.precision) << " | "
+           << pct(b.other.classAccuracy) << " |\n";
+      }
+      md << "\n";
+    }
+    if (!r.trueDirections.empty()) {
+      md << "### True directions instead of estimated ones\n\n"
+            "The same pipeline with its per-tile encoding directions taken from the truth "
+            "(`Demultiplexer::fixTileDirections`): what direction estimation costs.\n\n"
+            "| scene | directions | completeness, smooth | gross | RMSE disparity px | boundary "
+            "recall (mean) | boundary position RMS px (mean) |\n|---|---|---|---|---|---|---|\n";
+      for (const auto& t : r.trueDirections) {
+        for (const bool truth : {false, true}) {
+          const auto& f = truth ? t.truth : t.estimated;
+          double recall = 0;
+          double rms = 0;
+          for (const auto& b : t.boundaries) {
+            recall += (truth ? b.other : b.demux).recall / static_cast<double>(t.boundaries.size());
+            rms += (truth ? b.other : b.demux).positionRmsPx /
+                   static_cast<double>(t.boundaries.size());
+          }
+          md << "| " << t.scene << " | " << (truth ? "true" : "estimated") << " | "
+             << completeness(f.mergedSmooth) << " | " << pct(f.mergedAll.grossRate, 2) << " | "
+             << fixed(f.mergedAll.rmsDisparityPx, 3) << " | " << pct(recall, 2) << " | "
+             << fixed(rms, 3) << " |\n";
+        }
+      }
+      md << "\n";
+    }
+  }
+
+  void sweeps(const eval::Report& r) {
+    if (r.sweeps.empty()) {
+      return;
+    }
+    md << "## Robustness sweeps\n\n"
+          "One condition varied at a time from the sphere scene's (a sphere before a wall, "
+          "rig_2proj_1cam). \"Usable\": smooth completeness ≥ "
+       << pct(kUsableCompleteness, 0) << " and gross errors ≤ " << pct(kUsableGross, 0) << ".\n\n";
+    for (const auto& s : r.sweeps) {
+      md << "### " << s.name << "\n\n"
+         << s.quantity << ".\n\n"
+         << "| value | stripe width px | completeness, smooth | lit by 2 | gross | RMSE "
+            "disparity px | usable |\n|---|---|---|---|---|---|---|\n";
+      plots::LineChart chart{"Sweep: " + s.name,
+                             s.quantity,
+                             "share",
+                             {{"completeness, smooth", {}, {}},
+                              {"completeness, lit by 2", {}, {}},
+                              {"gross errors x 10", {}, {}}},
+                             true,
+                             {},
+                             std::pair{0.0, 1.0}};
+      for (const auto& p : s.points) {
+        const auto& f = p.figures;
+        md << "| " << fixed(p.value, 2) << " | " << fixed(p.stripeWidthPx, 2) << " | "
+           << completeness(f.mergedSmooth) << " | " << completeness(f.merged2) << " | "
+           << pct(f.mergedAll.grossRate, 2) << " | " << fixed(f.mergedAll.rmsDisparityPx, 3)
+           << " | " << (usable(f) ? "yes" : "**no**") << " |\n";
+        chart.series[0].x.push_back(p.value);
+        chart.series[0].y.push_back(f.mergedSmooth.completeness);
+        chart.series[1].x.push_back(p.value);
+        chart.series[1].y.push_back(f.merged2.completeness);
+        chart.series[2].x.push_back(p.value);
+        chart.series[2].y.push_back(std::min(1.0, 10.0 * f.mergedAll.grossRate));
+      }
+      std::string unusable;
+      for (const auto& p : s.points) {
+        if (!usable(p.figures)) {
+          unusable += (unusable.empty() ? "" : ", ") + fixed(p.value, 2);
+        }
+      }
+      md << "\n"
+         << (unusable.empty() ? "Usable over the whole range." : "Not usable at: " + unusable + ".")
+         << "\n";
+      const std::string name = "sweep_" + slug(s.name) + ".png";
+      plot(plots::writeLineChart(png(name), chart));
+      md << "\n";
+      image("sweep " + s.name, name);
+      md << "\n";
+    }
+  }
+};
+
+}  // namespace
+
+std::expected<void, std::string> writeEvalReport(const fs::path& dir, const eval::Report& report,
+                                                 const std::string& command) {
+  Writer w{dir, {}, {}};
+  std::error_code ec;
+  fs::create_directories(dir / "results", ec);
+  if (!ec) {
+    // Plots of an earlier run that this one does not make must not linger; other files stay.
+    for (const auto& entry : fs::directory_iterator(dir / "results", ec)) {
+      const std::string name = entry.path().filename().string();
+      if (entry.path().extension() == ".png" &&
+          (name.starts_with("error_") || name.starts_with("sweep_") || name.starts_with("table2") ||
+           name == "completeness.png")) {
+        fs::remove(entry.path(), ec);
+      }
+    }
+  }
+  if (ec) {
+    return std::unexpected("cannot create " + (dir / "results").string() + ": " + ec.message());
+  }
+  w.md << "# stripemux: evaluation results\n\n"
+          "Measured on the simulator's renders with the firmware's own per-frame pipeline. "
+          "Regenerate with\n\n```\n"
+       << command
+       << "\n```\n\n"
+          "Definitions (docs/results.md is generated; the code is tools/host/eval/): "
+          "completeness = pixels with depth / pixels of the region (lit by ≥ 1 projector: every "
+          "pixel; \"smooth\": 3 px inside, away from depth jumps); gross = |z − z_truth| > "
+          "max(5 mm, 1 %), as a share of the pixels with depth; RMSE over the others, in mm and "
+          "as the equivalent disparity error in camera pixels (f·b·|Δz| / z²).\n\n";
+  w.scenes(report);
+  w.flat(report);
+  w.table2(report);
+  w.baselines(report);
+  w.sweeps(report);
+  if (!w.error.empty()) {
+    return std::unexpected(w.error);
+  }
+  std::ofstream out(dir / "results.md");
+  out << w.md.str();
+  if (!out) {
+    return std::unexpected("cannot write " + (dir / "results.md").string());
+  }
+  return {};
+}
+
+}  // namespace smx::host
