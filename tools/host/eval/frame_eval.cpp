@@ -103,6 +103,12 @@ FrameFigures measureFrame(const SimFrame& frame, int camera, const algo::CameraP
   for (int p = 0; p < pipeline.projectors(); ++p) {
     fig.pairs.push_back(
         scorePair(frame, camera, pipeline, p, litRegion(frame, {.smooth = true, .projector = p})));
+    fig.pairs2.push_back(scorePair(
+        frame, camera, pipeline, p,
+        litRegion(frame, {.patterns = 2, .exactly = true, .smooth = true, .projector = p})));
+    fig.pairs3.push_back(scorePair(
+        frame, camera, pipeline, p,
+        litRegion(frame, {.patterns = 3, .exactly = true, .smooth = true, .projector = p})));
   }
   return fig;
 }

@@ -23,25 +23,10 @@ namespace smx::eval {
 
 namespace {
 
-using Vec = std::array<double, 3>;
+using Vec = Eigen::Vector3d;
 
-Vec add(const Vec& a, const Vec& b) {
-  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-}
-Vec sub(const Vec& a, const Vec& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-Vec scale(const Vec& a, double s) {
-  return {a[0] * s, a[1] * s, a[2] * s};
-}
-double dot(const Vec& a, const Vec& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec unit(const Vec& a) {
-  return scale(a, 1.0 / std::sqrt(dot(a, a)));
+std::array<double, 3> toArray(const Vec& v) {
+  return {v.x(), v.y(), v.z()};
 }
 
 // Station i's direction from the sphere centre: a regular tetrahedron with station 0 towards −z
@@ -59,30 +44,30 @@ Vec stationDirection(int station) {
 // The station's tangent frame (x, y), in which Table2Geometry::baselineAngleDeg is measured:
 // x = up × d (up = −y, or +x for a station straight above or below), y = d × x.
 std::pair<Vec, Vec> tangentFrame(const Vec& d) {
-  const Vec up = std::abs(d[1]) < 0.9 ? Vec{0.0, -1.0, 0.0} : Vec{1.0, 0.0, 0.0};
-  const Vec x = unit(cross(up, d));
-  return {x, cross(d, x)};
+  const Vec up = std::abs(d.y()) < 0.9 ? Vec(0.0, -1.0, 0.0) : Vec(1.0, 0.0, 0.0);
+  const Vec x = up.cross(d).normalized();
+  return {x, d.cross(x)};
 }
 
 // Rows of R (device x, y, z in world coordinates) for a device at `eye` aimed at `aim`:
 // with `along` (a world direction), the device x axis is `along` as seen at the principal point;
 // without, the device is level (x horizontal).
 std::array<Vec, 3> lookAt(const Vec& eye, const Vec& aim, std::optional<Vec> along) {
-  const Vec z = unit(sub(aim, eye));
-  Vec x = unit(cross({0.0, 1.0, 0.0}, z));
+  const Vec z = (aim - eye).normalized();
+  Vec x = Vec(0.0, 1.0, 0.0).cross(z).normalized();
   if (along) {
-    x = unit(sub(*along, scale(z, dot(*along, z))));
+    x = (*along - z * along->dot(z)).normalized();
   }
-  return {x, cross(z, x), z};
+  return {x, z.cross(x), z};
 }
 
 template <class Device>
 void place(Device& device, const Vec& centre, const std::array<Vec, 3>& rows) {
   for (std::size_t r = 0; r < 3; ++r) {
     for (std::size_t c = 0; c < 3; ++c) {
-      device.R[3 * r + c] = rows[r][c];
+      device.R[3 * r + c] = rows[r][static_cast<Eigen::Index>(c)];
     }
-    device.t[r] = -dot(rows[r], centre);
+    device.t[r] = -rows[r].dot(centre);
   }
 }
 
@@ -94,10 +79,9 @@ std::optional<Vec> worldPoint(const algo::Camera& cam, int x, int y, double zM) 
   if (!n) {
     return std::nullopt;
   }
-  const Vec c = {n->x * zM - cam.t[0], n->y * zM - cam.t[1], zM - cam.t[2]};
-  const auto& r = cam.R;
-  return Vec{r[0] * c[0] + r[3] * c[1] + r[6] * c[2], r[1] * c[0] + r[4] * c[1] + r[7] * c[2],
-             r[2] * c[0] + r[5] * c[1] + r[8] * c[2]};
+  const Vec c(n->x * zM - cam.t[0], n->y * zM - cam.t[1], zM - cam.t[2]);
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r(cam.R.data());
+  return Vec(r.transpose() * c);
 }
 
 bool onSurface(float zTruth) {
@@ -155,7 +139,8 @@ Table2Row measureConfig(const Table2Config& config, const Table2Options& options
   const Table2Geometry& g = options.geometry;
   const algo::Rig rig = table2Rig(config.projectors, config.cameras, g);
   const sim::Scene scene = table2Scene(g);
-  const Vec centre = table2Centre(g);
+  const auto c = table2Centre(g);
+  const Vec centre(c[0], c[1], c[2]);
   SphereCoverage measured = SphereCoverage::forBinArea(g.sphereRadiusM, options.binAreaM2);
   SphereCoverage geometric = SphereCoverage::forBinArea(g.sphereRadiusM, options.binAreaM2);
 
@@ -191,7 +176,7 @@ Table2Row measureConfig(const Table2Config& config, const Table2Options& options
         }
         if (anyLit) {
           if (const auto w = worldPoint(cam, x, y, zTruth)) {
-            geometric.add(sub(*w, centre));
+            geometric.add(toArray(*w - centre));
           }
         }
       }
@@ -258,7 +243,7 @@ Table2Row measureConfig(const Table2Config& config, const Table2Options& options
             continue;
           }
           if (const auto w = worldPoint(cam, x, y, zM)) {
-            measured.add(sub(*w, centre));
+            measured.add(toArray(*w - centre));
           }
         }
       }
@@ -292,15 +277,16 @@ algo::Rig table2Rig(int projectors, int cameras, const Table2Geometry& g) {
   if (projectors < 1 || projectors > kTable2Stations || cameras < 1 || cameras > kTable2Stations) {
     throw std::invalid_argument("table2Rig: 1..4 projectors and 1..4 cameras");
   }
-  const Vec centre = table2Centre(g);
+  const auto c = table2Centre(g);
+  const Vec centre(c[0], c[1], c[2]);
   algo::Rig rig;
   for (int i = 0; i < kTable2Stations; ++i) {
     const Vec d = stationDirection(i);
     const auto [tx, ty] = tangentFrame(d);
     const double a = g.baselineAngleDeg[static_cast<std::size_t>(i)] * std::numbers::pi / 180.0;
-    const Vec baseline = add(scale(tx, std::cos(a)), scale(ty, std::sin(a)));
-    const Vec camCentre = add(centre, scale(d, g.stationDistanceM));
-    const Vec projCentre = add(camCentre, add(scale(baseline, g.baselineM), scale(d, g.setbackM)));
+    const Vec baseline = tx * std::cos(a) + ty * std::sin(a);
+    const Vec camCentre = centre + d * g.stationDistanceM;
+    const Vec projCentre = camCentre + baseline * g.baselineM + d * g.setbackM;
     const std::string n = std::to_string(i);
     if (i < cameras) {
       algo::Camera cam;
@@ -320,7 +306,7 @@ algo::Rig table2Rig(int projectors, int cameras, const Table2Geometry& g) {
       proj.K = {1400.0, 0.0, 511.5, 0.0, 1400.0, 383.5, 0.0, 0.0, 1.0};
       proj.dist = {};
       // Pattern axis (angle 0 = device x) along the baseline to this station's camera.
-      place(proj, projCentre, lookAt(projCentre, centre, sub(projCentre, camCentre)));
+      place(proj, projCentre, lookAt(projCentre, centre, Vec(projCentre - camCentre)));
       proj.pattern = {0.0, g.stripePx, 0.0};
       rig.projectors.push_back(proj);
     }
@@ -333,7 +319,7 @@ sim::Scene table2Scene(const Table2Geometry& g) {
   sim::Object ball;
   ball.name = "ball";
   ball.shape = sim::Sphere{g.sphereRadiusM};
-  const Vec c = table2Centre(g);
+  const auto c = table2Centre(g);
   ball.pose.t = sim::Vec3(c[0], c[1], c[2]);
   ball.albedo.rgb = sim::Vec3(0.85, 0.85, 0.85);
   scene.objects.push_back(ball);
@@ -356,7 +342,7 @@ SphereCoverage SphereCoverage::forBinArea(double radiusM, double binAreaM2) {
 }
 
 void SphereCoverage::add(const std::array<double, 3>& direction) {
-  const double len = std::sqrt(dot(direction, direction));
+  const double len = Vec(direction[0], direction[1], direction[2]).norm();
   if (!(len > 0.0) || !std::isfinite(len)) {
     return;
   }

@@ -55,11 +55,13 @@ struct RegionSpec {
                                    const Mask& region);
 
 struct FrameFigures {
-  DepthScore mergedAll;           // lit by ≥ 1, every pixel (gross errors at edges count)
-  DepthScore mergedSmooth;        // lit by ≥ 1, smooth interior (completeness)
-  DepthScore merged2;             // lit by exactly 2, smooth interior
-  DepthScore merged3;             // lit by exactly 3, smooth interior
-  std::vector<DepthScore> pairs;  // each projector where it lights the surface, smooth
+  DepthScore mergedAll;            // lit by ≥ 1, every pixel (gross errors at edges count)
+  DepthScore mergedSmooth;         // lit by ≥ 1, smooth interior (completeness)
+  DepthScore merged2;              // lit by exactly 2, smooth interior
+  DepthScore merged3;              // lit by exactly 3, smooth interior
+  std::vector<DepthScore> pairs;   // each projector where it lights the surface, smooth
+  std::vector<DepthScore> pairs2;  // each projector where it and exactly 1 other light, smooth
+  std::vector<DepthScore> pairs3;  // each projector where exactly 3 light, smooth
 };
 [[nodiscard]] FrameFigures measureFrame(const SimFrame& frame, int camera,
                                         const algo::CameraPipeline& pipeline);
