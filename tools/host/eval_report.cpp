@@ -146,7 +146,9 @@ struct Writer {
           "depth / pixels of the smooth lit target) and the RMS distance of the points to their "
           "least-squares plane (spatial noise), with the RMSE against the truth beside it. The "
           "target is the smooth lit surface at the image centre (truth depth within 2 cm of "
-          "the centre's).\n\n"
+          "the centre's). The fit takes every pixel with depth, gross errors included, as a "
+          "quality tool does, so a handful of wrong pixels shows in it where the RMSE (which "
+          "leaves gross errors out) does not.\n\n"
           "| target | distance m | fill rate | plane-fit RMS mm | RMSE mm | RMSE disparity px |"
           " gross |\n|---|---|---|---|---|---|---|\n";
     auto row = [&](const eval::FlatRun& f) {
