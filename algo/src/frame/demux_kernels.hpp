@@ -119,11 +119,17 @@ inline constexpr std::size_t kFilterRows = std::size_t{kFilterSlots} * 3 * 3;
          static_cast<std::size_t>(filter);
 }
 
-// The derivatives of the current row separate() steers from, per channel: gx, gy, hxx, hyy, hxy.
+// The derivatives of the current row separate() steers from, per channel: gx, gy, hxx, hyy, hxy;
+// then every projector's unit vectors (cos, sin; Q1.14) along the current row.
 enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
-inline constexpr std::size_t kDerivativeRows = std::size_t{3} * kDerivativeKinds;
+inline constexpr std::size_t kDerivativeRows =
+    std::size_t{3} * kDerivativeKinds + std::size_t{2} * kMaxProjectors;
 [[nodiscard]] constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
   return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
+}
+[[nodiscard]] constexpr std::size_t unitRowIndex(int projector, int component) {
+  return std::size_t{3} * kDerivativeKinds + static_cast<std::size_t>(projector) * 2 +
+         static_cast<std::size_t>(component);
 }
 
 // The signed difference a − b of two BinAngle raw values, wrapped into [−2^15, 2^15).
