@@ -60,6 +60,103 @@ Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
   return lobe;
 }
 
+// Sums of tile histograms (weights and first moments, 64 bits) over a set of tiles.
+struct BinSums {
+  std::uint64_t weights[kBins] = {};
+  std::int64_t moments[kBins] = {};
+
+  void clear() {
+    for (int k = 0; k < kBins; ++k) {
+      weights[k] = 0;
+      moments[k] = 0;
+    }
+  }
+  void add(const BinSums& other) {
+    for (int k = 0; k < kBins; ++k) {
+      weights[k] += other.weights[k];
+      moments[k] += other.moments[k];
+    }
+  }
+  void subtract(const BinSums& other) {
+    for (int k = 0; k < kBins; ++k) {
+      weights[k] -= other.weights[k];
+      moments[k] -= other.moments[k];
+    }
+  }
+};
+
+constexpr int kMaxWindowTiles = 9;  // DemuxParams::windowTiles, as create() validates it
+
+// The window histogram of every tile along a tile row, as separable sums sliding along x: each
+// tile column's sum over the window's tile rows is formed once, and the window moves by adding
+// the column that enters and subtracting the one that leaves, instead of adding windowTiles²
+// tiles per tile. Integer sums are exact, so the result equals the direct sum bit for bit.
+class WindowSums {
+ public:
+  WindowSums(std::span<const std::uint32_t> histograms, std::span<const std::int32_t> moments,
+             int tilesX, int tilesY, int radius)
+      : histograms_(histograms),
+        moments_(moments),
+        tilesX_(tilesX),
+        tilesY_(tilesY),
+        radius_(radius) {}
+
+  // The window of tile (0, ty).
+  void start(int ty) {
+    ty_ = ty;
+    window_.clear();
+    for (int i = 0; i <= radius_ && i < tilesX_; ++i) {
+      BinSums& column = slot(i);
+      sumColumn(i, column);
+      window_.add(column);
+    }
+  }
+  // From the window of tile (tx − 1, ty) to that of (tx, ty).
+  void step(int tx) {
+    const int leaving = tx - radius_ - 1;
+    const int entering = tx + radius_;
+    if (leaving >= 0) {
+      window_.subtract(slot(leaving));
+    }
+    if (entering < tilesX_) {
+      BinSums& column = slot(entering);  // the leaving column's slot
+      sumColumn(entering, column);
+      window_.add(column);
+    }
+  }
+  [[nodiscard]] const BinSums& sums() const { return window_; }
+
+ private:
+  BinSums& slot(int tileX) { return columns_[static_cast<std::size_t>(tileX % (2 * radius_ + 1))]; }
+  // Tile column i's histograms over the tile rows ty − r … ty + r inside the grid.
+  void sumColumn(int i, BinSums& column) const {
+    column.clear();
+    for (int j = ty_ - radius_; j <= ty_ + radius_; ++j) {
+      if (j < 0 || j >= tilesY_) {
+        continue;
+      }
+      const std::size_t offset = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
+                                  static_cast<std::size_t>(i)) *
+                                 kBins;
+      const std::uint32_t* weights = histograms_.data() + offset;
+      const std::int32_t* moments = moments_.data() + offset;
+      for (int k = 0; k < kBins; ++k) {
+        column.weights[k] += weights[k];
+        column.moments[k] += moments[k];
+      }
+    }
+  }
+
+  std::span<const std::uint32_t> histograms_;
+  std::span<const std::int32_t> moments_;
+  int tilesX_;
+  int tilesY_;
+  int radius_;
+  int ty_ = 0;
+  BinSums window_;
+  BinSums columns_[kMaxWindowTiles];
+};
+
 // Where a projector's lobe was not found (its pattern faint or absent), the direction of the
 // tiles around that found it is a better guess than the flat-surface prediction: the mean offset
 // from the prediction over the present tiles within ±kFillRadius tiles, as wrapped differences.
@@ -240,31 +337,22 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
   const std::size_t tileCount = layout.tileCount();
   const int tolerance2 = (layout.params.lobeToleranceDeg * 2 * 65536) / 360;
   const auto minSharePct = static_cast<std::uint64_t>(layout.params.minLobeSharePct);
+  WindowSums windows(tileHistograms, tileMoments, tilesX, tilesY, r);
 
   for (int ty = 0; ty < tilesY; ++ty) {
     for (int tx = 0; tx < tilesX; ++tx) {
       const std::size_t tile = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
                                static_cast<std::size_t>(tx);
-      // The window histogram.
-      std::uint64_t hist[kBins] = {};
-      std::int64_t moment[kBins] = {};
+      if (tx == 0) {
+        windows.start(ty);
+      } else {
+        windows.step(tx);
+      }
+      const auto& hist = windows.sums().weights;
+      const auto& moment = windows.sums().moments;
       std::uint64_t total = 0;
-      for (int j = ty - r; j <= ty + r; ++j) {
-        for (int i = tx - r; i <= tx + r; ++i) {
-          if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-            continue;
-          }
-          const std::uint32_t* src = tileHistograms.data() + (static_cast<std::size_t>(j) *
-                                                                  static_cast<std::size_t>(tilesX) +
-                                                              static_cast<std::size_t>(i)) *
-                                                                 kBins;
-          const std::int32_t* srcMoments = tileMoments.data() + (src - tileHistograms.data());
-          for (int k = 0; k < kBins; ++k) {
-            hist[k] += src[k];
-            moment[k] += srcMoments[k];
-            total += src[k];
-          }
-        }
+      for (const std::uint64_t weight : hist) {
+        total += weight;
       }
       // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4).
       Lobe lobes[kMaxLobes];
