@@ -65,6 +65,21 @@ std::optional<Point2> project(const DeviceModel& d, const Point3& world) {
   return Point2{d.fx() * xd.x + d.cx(), d.fy() * xd.y + d.cy()};
 }
 
+Point3 toWorld(const DeviceModel& d, const Point3& local) {
+  const auto& r = d.R;
+  const Point3 c = {local[0] - d.t[0], local[1] - d.t[1], local[2] - d.t[2]};
+  return {r[0] * c[0] + r[3] * c[1] + r[6] * c[2], r[1] * c[0] + r[4] * c[1] + r[7] * c[2],
+          r[2] * c[0] + r[5] * c[1] + r[8] * c[2]};
+}
+
+std::optional<Point3> devicePoint(const DeviceModel& d, Point2 pixel, double z) {
+  const auto xn = undistort(d.dist, {(pixel.x - d.cx()) / d.fx(), (pixel.y - d.cy()) / d.fy()});
+  if (!xn) {
+    return std::nullopt;
+  }
+  return Point3{xn->x * z, xn->y * z, z};
+}
+
 std::optional<Ray> pixelRay(const DeviceModel& d, Point2 pixel) {
   const auto xn = undistort(d.dist, {(pixel.x - d.cx()) / d.fx(), (pixel.y - d.cy()) / d.fy()});
   if (!xn) {

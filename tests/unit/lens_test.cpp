@@ -65,6 +65,29 @@ TEST(Lens, PixelRayAndProjectAreInverse) {
   }
 }
 
+// A range image's pixel and depth back to a world point: it lies at that depth in the device
+// frame and projects onto the same pixel.
+TEST(Lens, DevicePointAtADepthProjectsBackToItsPixel) {
+  const auto d = makeDevice({-0.2, 0.05, 0.001, 0.0005, 0.0});
+  for (double px = 0; px < 640; px += 63.7) {
+    for (double py = 0; py < 480; py += 47.3) {
+      const double z = 0.6 + py / 1000.0;
+      const auto local = devicePoint(d, {px, py}, z);
+      ASSERT_TRUE(local.has_value());
+      EXPECT_DOUBLE_EQ((*local)[2], z);
+      const Point3 world = toWorld(d, *local);
+      const Point3 again = toDevice(d, world);
+      for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_NEAR(again[i], (*local)[i], 1e-12);
+      }
+      const auto back = project(d, world);
+      ASSERT_TRUE(back.has_value());
+      EXPECT_NEAR(back->x, px, 1e-8);
+      EXPECT_NEAR(back->y, py, 1e-8);
+    }
+  }
+}
+
 TEST(Lens, CentreAndProjectionOfAKnownPoint) {
   const auto d = makeDevice({0, 0, 0, 0, 0});
   const auto c = centre(d);

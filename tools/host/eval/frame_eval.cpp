@@ -129,11 +129,9 @@ PlaneFit fitPlane(const algo::Camera& camera, algo::ConstDepthPlane depth,
       if (depth(x, y) == algo::kNoDepth) {
         continue;
       }
-      const auto n = algo::lens::undistort(
-          camera.dist, {(x - camera.cx()) / camera.fx(), (y - camera.cy()) / camera.fy()});
-      if (n) {
-        const double z = depth(x, y) * depthUnitM;
-        points.emplace_back(n->x * z, n->y * z, z);
+      if (const auto p = algo::lens::devicePoint(
+              camera, {static_cast<double>(x), static_cast<double>(y)}, depth(x, y) * depthUnitM)) {
+        points.emplace_back((*p)[0], (*p)[1], (*p)[2]);
       }
     }
   }

@@ -72,16 +72,15 @@ void place(Device& device, const Vec& centre, const std::array<Vec, 3>& rows) {
 }
 
 // World point seen at camera pixel (x, y) at depth z (camera frame); nullopt where the lens model
-// cannot be inverted. The host back-projection of tools/host/point_cloud.cpp.
+// cannot be inverted.
 std::optional<Vec> worldPoint(const algo::Camera& cam, int x, int y, double zM) {
-  const auto n =
-      algo::lens::undistort(cam.dist, {(x - cam.cx()) / cam.fx(), (y - cam.cy()) / cam.fy()});
-  if (!n) {
+  const auto local =
+      algo::lens::devicePoint(cam, {static_cast<double>(x), static_cast<double>(y)}, zM);
+  if (!local) {
     return std::nullopt;
   }
-  const Vec c(n->x * zM - cam.t[0], n->y * zM - cam.t[1], zM - cam.t[2]);
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r(cam.R.data());
-  return Vec(r.transpose() * c);
+  const auto w = algo::lens::toWorld(cam, *local);
+  return Vec(w[0], w[1], w[2]);
 }
 
 bool onSurface(float zTruth) {

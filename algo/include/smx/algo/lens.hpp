@@ -31,6 +31,14 @@ struct Ray {
 // World point → device frame: x_dev = R·X + t.
 [[nodiscard]] Point3 toDevice(const DeviceModel& device, const Point3& world);
 
+// Device frame → world: X = Rᵀ·(x_dev − t).
+[[nodiscard]] Point3 toWorld(const DeviceModel& device, const Point3& local);
+
+// Pixel coordinates and z (depth along the device's optical axis) → the point in the device
+// frame, z·(x_n, y_n, 1) with (x_n, y_n) undistorted; nullopt if the distortion cannot be
+// inverted there. How a range image becomes points.
+[[nodiscard]] std::optional<Point3> devicePoint(const DeviceModel& device, Point2 pixel, double z);
+
 // Device centre in world coordinates: −Rᵀ·t.
 [[nodiscard]] Point3 centre(const DeviceModel& device);
 
