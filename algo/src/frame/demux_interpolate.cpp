@@ -34,27 +34,42 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
                            std::span<const DirectionPlane> out) {
   const int tilesX = layout.tilesX();
   const std::size_t tileCount = layout.tileCount();
+  const int w = layout.width;
   for (int p = 0; p < layout.projectors; ++p) {
-    const std::span<const TileDirection> mine =
-        tiles.subspan(static_cast<std::size_t>(p) * tileCount, tileCount);
-    const auto angleAt = [&](int tx, int ty) {
-      return mine[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
-                  static_cast<std::size_t>(tx)]
-          .angle;
-    };
+    const TileDirection* mine = tiles.data() + static_cast<std::size_t>(p) * tileCount;
     for (int y = 0; y < layout.height; ++y) {
       const TileInterp& ry = rows[static_cast<std::size_t>(y)];
-      const std::int64_t wy = ry.weight;
+      const std::int32_t wy = ry.weight;
+      const TileDirection* lowerRow =
+          mine + static_cast<std::size_t>(ry.lower) * static_cast<std::size_t>(tilesX);
+      const TileDirection* upperRow =
+          mine + static_cast<std::size_t>(ry.upper) * static_cast<std::size_t>(tilesX);
       std::uint16_t* dst = out[static_cast<std::size_t>(p)].rowPtr(y);
-      for (int x = 0; x < layout.width; ++x) {
+      // Between two tile centres the four corners are fixed, and the bilinear sum
+      //   d10·wx·(256 − wy) + d01·(256 − wx)·wy + d11·wx·wy + 2^15 = wx·slope + 256·base
+      // is one multiply-add per pixel. Where the weight is 0 (outside the outer tile centres)
+      // the upper column does not count, so the corners change only with the lower column.
+      int lower = -1;
+      std::uint16_t a00 = 0;
+      std::int32_t slope = 0;
+      std::int32_t base = 0;
+      for (int x = 0; x < w; ++x) {
         const TileInterp& cx = columns[static_cast<std::size_t>(x)];
-        const std::uint16_t a00 = angleAt(cx.lower, ry.lower);
-        const std::int64_t d10 = wrapDiff(angleAt(cx.upper, ry.lower), a00);
-        const std::int64_t d01 = wrapDiff(angleAt(cx.lower, ry.upper), a00);
-        const std::int64_t d11 = wrapDiff(angleAt(cx.upper, ry.upper), a00);
-        const std::int64_t wx = cx.weight;
-        const std::int64_t delta =
-            (d10 * wx * (256 - wy) + d01 * (256 - wx) * wy + d11 * wx * wy + 32768) >> 16;
+        if (cx.lower != lower) {
+          lower = cx.lower;
+          const auto l = static_cast<std::size_t>(lower);
+          const auto u = static_cast<std::size_t>(lower + 1 < tilesX ? lower + 1 : lower);
+          a00 = lowerRow[l].angle;
+          const std::int32_t d10 = wrapDiff(lowerRow[u].angle, a00);
+          const std::int32_t d01 = wrapDiff(upperRow[l].angle, a00);
+          const std::int32_t d11 = wrapDiff(upperRow[u].angle, a00);
+          slope = d10 * (256 - wy) + (d11 - d01) * wy;  // |slope| < 2^25
+          base = d01 * wy + 128;                        // |base| < 2^23
+        }
+        // wx·slope + 256·base overflows int32; its >> 16 is taken as
+        // (wx·(slope >> 8) + base + (wx·(slope & 255) >> 8)) >> 8, the same integer.
+        const std::int32_t wx = cx.weight;
+        const std::int32_t delta = (wx * (slope >> 8) + base + ((wx * (slope & 255)) >> 8)) >> 8;
         dst[x] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
       }
     }
