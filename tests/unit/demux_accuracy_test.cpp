@@ -19,6 +19,7 @@
 #include "smx/algo/demux.hpp"
 #include "smx/eval/boundary_eval.hpp"
 #include "smx/eval/sim_frame.hpp"
+#include "smx/sim/scene.hpp"
 
 namespace smx::algo {
 namespace {
@@ -40,9 +41,9 @@ Figures measure(const eval::SimFrame& f, const Demultiplexer& d, int p, int patt
   const auto& b = fig.boundaries;
   std::printf(
       "%-22s proj%d lit by %d: %6d px | direction median %.2f p95 %.2f deg | boundaries %6d "
-      "recall %.4f precision %.4f class %.4f position rms %.3f px\n",
+      "recall %.4f precision %.4f class %.4f position rms %.3f mean %+.3f px\n",
       label.c_str(), p, patterns, region.count(), fig.directions.medianDeg, fig.directions.p95Deg,
-      b.trueBoundaries, b.recall, b.precision, b.classAccuracy, b.positionRmsPx);
+      b.trueBoundaries, b.recall, b.precision, b.classAccuracy, b.positionRmsPx, b.positionMeanPx);
   return fig;
 }
 
@@ -68,9 +69,46 @@ void expectWithin(const Figures& fig, const Limits& l, const std::string& what) 
 
 constexpr Limits kTwoPatternTargets{2.0, 5.0, 0.98, 0.98, 0.99, 0.15};
 
+// The frames are rendered with 4 × 4 samples per pixel. With the scenes' 2 × 2, a stripe edge
+// across a pixel covers 0, ½ or 1 of its samples, so the image itself places the edge only to
+// within ½ px (an RMS of 0.14 px for axis-aligned stripes, whatever the estimator); a camera
+// integrates over the whole pixel. RenderSamplingSetsThePositionFloor measures it.
+constexpr int kSupersampling = 4;
+
+eval::SimFrame render(const algo::Rig& rig, const std::string& scene,
+                      int supersampling = kSupersampling) {
+  sim::Scene s = eval::loadNamedScene(scene);
+  s.supersampling = supersampling;
+  return eval::renderSimFrame(rig, s);
+}
+
+eval::SimFrame render(const std::string& rigFile, const std::string& scene,
+                      int supersampling = kSupersampling) {
+  return render(eval::loadExampleRig(rigFile), scene, supersampling);
+}
+
+// Given the flat board rendered with 2 × 2, 4 × 4 and 6 × 6 samples per pixel, the position error
+// falls with the sampling (the 2 × 2 render quantises the edges), while recall stays.
+TEST(DemuxAccuracy, RenderSamplingSetsThePositionFloor) {
+  double rms[3] = {};
+  const int samplings[3] = {2, 4, 6};
+  for (int i = 0; i < 3; ++i) {
+    const auto f = render("rig_2proj_1cam.json", "plane", samplings[i]);
+    const auto d = test::demultiplex(f);
+    const Figures fig = measure(
+        f, *d->demux, 0, 2,
+        "plane " + std::to_string(samplings[i]) + "x" + std::to_string(samplings[i]) + " samples");
+    EXPECT_GE(fig.boundaries.recall, 0.98);
+    rms[i] = fig.boundaries.positionRmsPx;
+  }
+  EXPECT_GT(rms[0], 0.12) << "2 x 2 samples place an edge to within half a pixel";
+  EXPECT_LT(rms[1], 0.7 * rms[0]);
+  EXPECT_LT(rms[2], rms[1]);
+}
+
 // Given the flat board and two patterns 90° apart, every target holds for both projectors.
 TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
-  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "plane"});
+  const auto f = render("rig_2proj_1cam.json", "plane");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 90deg"), kTwoPatternTargets,
@@ -82,7 +120,7 @@ TEST(DemuxAccuracy, TwoPatterns90DegOnAPlaneMeetTheTargets) {
 TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
   auto rig = eval::loadExampleRig("rig_2proj_1cam.json");
   rig.projectors[1].pattern.angleDeg = 70.0;
-  const auto f = eval::renderSimFrame(rig, eval::loadNamedScene("plane"));
+  const auto f = render(rig, "plane");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "plane 70deg"), kTwoPatternTargets,
@@ -93,38 +131,37 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 // A sphere before a wall: curved surface, shadows, an occluding contour. Towards the sphere's rim
 // one pattern arrives at grazing incidence and fades: its lobe is lost there and the direction
 // is guessed from the tiles around, so the 95th percentile is far off target (ratchet: 15°);
-// boundaries are within a point of the targets (ratchet).
+// recall is just under target for one projector (ratchet 97.5 %); the position error meets it.
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
-  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "sphere"});
+  const auto f = render("rig_2proj_1cam.json", "sphere");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"),
-                 {1.0, 15.0, 0.975, 0.985, 0.985, 0.16}, "projector " + std::to_string(p));
-    expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.16},
+                 {1.0, 15.0, 0.975, 0.985, 0.985, 0.15}, "projector " + std::to_string(p));
+    expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.15},
                  "projector " + std::to_string(p) + " alone");
   }
 }
 
-// Three patterns 60° apart on the board: directions, recall, precision and class meet the
-// targets; the position error of one projector does not yet (ratchet: RMS 0.16 px).
+// Three patterns 60° apart on the board: every target holds for each projector.
 TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
-  const auto f = eval::renderSimFrame({"rig_3proj_1cam.json", "plane"});
+  const auto f = render("rig_3proj_1cam.json", "plane");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 3; ++p) {
-    expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"), {2.0, 5.0, 0.98, 0.99, 0.99, 0.16},
+    expectWithin(measure(f, *d->demux, p, 3, "plane 3 x 60deg"), {2.0, 5.0, 0.98, 0.99, 0.99, 0.15},
                  "projector " + std::to_string(p));
   }
 }
 
 // The RGBCMY panel (paper Fig. 13): strong surface colours, divided out by the local average.
 // Directions, recall, precision and class accuracy meet the targets (97 % class on the panel);
-// the position error at the colour edges does not yet (ratchet 0.21 px).
+// the position error at the colour edges does not yet (ratchet 0.18 px).
 TEST(DemuxAccuracy, TwoPatternsOnTheRgbcmyPanel) {
-  const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", "rgbcmy_panel"});
+  const auto f = render("rig_2proj_1cam.json", "rgbcmy_panel");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "rgbcmy panel 90deg"),
-                 {2.0, 5.0, 0.98, 0.98, 0.97, 0.21}, "projector " + std::to_string(p));
+                 {2.0, 5.0, 0.98, 0.98, 0.97, 0.18}, "projector " + std::to_string(p));
   }
 }
 
