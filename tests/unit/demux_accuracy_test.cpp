@@ -19,7 +19,6 @@
 #include "smx/algo/demux.hpp"
 #include "smx/eval/boundary_eval.hpp"
 #include "smx/eval/sim_frame.hpp"
-#include "smx/sim/scene.hpp"
 
 namespace smx::algo {
 namespace {
@@ -77,9 +76,7 @@ constexpr int kSupersampling = 4;
 
 eval::SimFrame render(const algo::Rig& rig, const std::string& scene,
                       int supersampling = kSupersampling) {
-  sim::Scene s = eval::loadNamedScene(scene);
-  s.supersampling = supersampling;
-  return eval::renderSimFrame(rig, s);
+  return eval::renderSimFrame(rig, eval::loadNamedScene(scene), {.supersampling = supersampling});
 }
 
 eval::SimFrame render(const std::string& rigFile, const std::string& scene,

@@ -1,4 +1,5 @@
 // stripemux eval [--out DIR] [--only SECTION,...] [--scene NAME ...] [--seed N]
+//                [--supersampling N]
 // The evaluation suite: the named scenes rendered by the simulator, decoded by the firmware's
 // pipeline and scored against the truth; writes DIR/results.md and DIR/results/*.png
 // (docs/results.md is this command's output with the defaults).
@@ -15,6 +16,7 @@
 #include "eval_report.hpp"
 #include "smx/eval/suite.hpp"
 #include "smx/sim/named_scenes.hpp"
+#include "smx/sim/scene.hpp"
 
 namespace smx::host {
 namespace {
@@ -24,6 +26,7 @@ struct EvalOptions {
   std::vector<std::string> only;
   std::vector<std::string> scenes;
   std::uint64_t seed = 1;
+  int supersampling = 0;
 };
 
 std::string commandLine(const EvalOptions& o) {
@@ -40,12 +43,16 @@ std::string commandLine(const EvalOptions& o) {
   if (o.seed != 1) {
     c += " --seed " + std::to_string(o.seed);
   }
+  if (o.supersampling != 0) {
+    c += " --supersampling " + std::to_string(o.supersampling);
+  }
   return c;
 }
 
 int runEval(const EvalOptions& o, const CliStreams& io) {
   eval::SuiteOptions suite;
   suite.seed = o.seed;
+  suite.supersampling = o.supersampling;
   if (!o.only.empty()) {
     suite.sections.clear();
     for (const auto& name : o.only) {
@@ -106,6 +113,9 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--scene", options->scenes,
                   "Only the suite's runs of these named scenes (repeatable)");
   cmd->add_option("--seed", options->seed, "Noise seed of the renders (default 1)");
+  cmd->add_option("--supersampling", options->supersampling,
+                  "Samples per pixel side of every render (default: the scenes' own, 2)")
+      ->check(CLI::Range(1, sim::kMaxSceneSupersampling));
   cmd->callback([options, &io, &exitCode] { exitCode = runEval(*options, io); });
 }
 

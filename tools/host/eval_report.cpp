@@ -70,13 +70,23 @@ struct Writer {
     md << "![" << alt << "](results/" << name << ")\n";
   }
 
+  // The default renders take the scenes' own 2 × 2 samples per pixel, which place a stripe edge
+  // only to within half a pixel (docs/demux.md "Accuracy").
+  static std::string samplingNote(const eval::Report& r) {
+    if (r.supersampling == 0) {
+      return "";
+    }
+    return ", " + std::to_string(r.supersampling) + " × " + std::to_string(r.supersampling) +
+           " samples per pixel";
+  }
+
   void scenes(const eval::Report& r) {
     if (r.scenes.empty()) {
       return;
     }
     md << "## Scenes\n\n"
           "Each named scene rendered by the simulator (the paper's noise, seed "
-       << r.seed
+       << r.seed << samplingNote(r)
        << ") and decoded by the firmware's camera pipeline; the merged range image of all "
           "projectors, scored against the truth depth.\n\n"
           "| scene | rig | camera | completeness, all lit | smooth | lit by 2 | lit by 3 | gross "

@@ -39,8 +39,6 @@ using config::jsonQuote;
 using config::Keys;
 using config::member;
 
-constexpr int kMaxSupersampling = 8;  // 64 rays per pixel: beyond that, render larger
-
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
                                                       "camera_response", "objects"};
 constexpr std::array<std::string_view, 5> kLightingKeys = {"ambient", "projector_power",
@@ -577,7 +575,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   const Json& doc = *parsed;
   Reader r;
   Scene scene;
-  r.integer(doc, "", "supersampling", 1, kMaxSupersampling, "samples per pixel side",
+  r.integer(doc, "", "supersampling", 1, kMaxSceneSupersampling, "samples per pixel side",
             scene.supersampling);
   readLighting(r, doc, scene.lighting);
   readCameraResponse(r, doc, scene.camera);

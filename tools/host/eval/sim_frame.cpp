@@ -57,7 +57,11 @@ SimFrame renderSimFrame(algo::Rig rig, const sim::Scene& scene, const SimRequest
   for (std::size_t p = 0; p < projectors; ++p) {
     truth.projectors.push_back({f.lit[p].view(), {}, {}, f.stripe[p].view()});
   }
-  auto renderer = sim::Renderer::create(f.rig, scene);
+  sim::Scene sampled = scene;
+  if (request.supersampling > 0) {
+    sampled.supersampling = request.supersampling;
+  }
+  auto renderer = sim::Renderer::create(f.rig, sampled);
   if (!renderer) {
     throw std::runtime_error(renderer.error());
   }

@@ -63,7 +63,9 @@ struct Runner {
            std::ranges::find(options.scenes, scene) != options.scenes.end();
   }
   [[nodiscard]] SimFrame render(const algo::Rig& rig, const sim::Scene& scene, int camera) const {
-    return renderSimFrame(rig, scene, {.camera = camera, .seed = options.seed});
+    return renderSimFrame(
+        rig, scene,
+        {.camera = camera, .seed = options.seed, .supersampling = options.supersampling});
   }
 
   void scenes() {
@@ -135,6 +137,7 @@ struct Runner {
     const auto start = Clock::now();
     Table2Options table2Options;
     table2Options.seed = options.seed;
+    table2Options.supersampling = options.supersampling;
     report.table2 = measureTable2(table2Options);
     note("table 2, " + std::to_string(report.table2.size()) + " configurations", start);
   }
@@ -353,6 +356,7 @@ Report runSuite(const SuiteOptions& options) {
   const auto start = Clock::now();
   Report report;
   report.seed = options.seed;
+  report.supersampling = options.supersampling;
   Runner runner{options, report};
   for (const Section s : options.sections) {
     switch (s) {

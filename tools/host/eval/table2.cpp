@@ -154,6 +154,7 @@ Table2Row measureConfig(const Table2Config& config, const Table2Options& options
     SimRequest request;
     request.camera = camera;
     request.seed = options.seed + static_cast<std::uint64_t>(camera);
+    request.supersampling = options.supersampling;
     const SimFrame f = renderSimFrame(rig, scene, request);
     const algo::Camera& cam = rig.cameras[static_cast<std::size_t>(camera)];
 

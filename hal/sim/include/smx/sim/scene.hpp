@@ -106,6 +106,9 @@ struct CameraResponse {
   double defocusSigmaPx = 0.0;              // Gaussian blur of the camera image, camera px
 };
 
+// The most samples per pixel side a scene asks for (64 rays per pixel: beyond that, render larger).
+inline constexpr int kMaxSceneSupersampling = 8;
+
 struct Scene {
   std::vector<Object> objects;
   Lighting lighting;

@@ -52,6 +52,7 @@ struct SimRequest {
   int camera = 0;
   int frame = 0;
   std::uint64_t seed = 1;
+  int supersampling = 0;  // samples per pixel side; 0: the scene's own
 };
 [[nodiscard]] SimFrame renderSimFrame(const SimRequest& request);
 [[nodiscard]] SimFrame renderSimFrame(const SimRequest& request, const sim::Scene& scene);

@@ -78,6 +78,7 @@ struct Sweep {
 
 struct Report {
   std::uint64_t seed = 1;
+  int supersampling = 0;
   std::vector<SceneRun> scenes;
   std::vector<FlatRun> flat;
   std::vector<FlatRun> distance;
@@ -95,6 +96,7 @@ enum class Section : std::uint8_t { kScenes, kFlat, kTable2, kBaselines, kSweeps
 
 struct SuiteOptions {
   std::uint64_t seed = 1;
+  int supersampling = 0;  // samples per pixel side of every render; 0: the scenes' own (2)
   std::vector<Section> sections = allSections();
   std::vector<std::string> scenes;                   // empty: every scene of the suite
   std::function<void(const std::string&)> progress;  // one line per finished run

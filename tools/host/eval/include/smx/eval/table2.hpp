@@ -138,6 +138,7 @@ struct Table2Options {
   std::vector<Table2Config> configs = table2PaperConfigs();  // 1P1C is measured in any case
   double binAreaM2 = kTable2BinAreaM2;
   std::uint64_t seed = 1;
+  int supersampling = 0;  // samples per pixel side; 0: the scene's own
 };
 
 // One row per requested configuration, in the requested order. Throws std::runtime_error when a
