@@ -35,8 +35,17 @@ std::unique_ptr<DemuxedFrame> demultiplex(const eval::SimFrame& frame,
 }
 
 eval::Mask regionLitBy(const eval::SimFrame& frame, int projector, int patterns) {
-  return eval::litRegion(
+  eval::Mask m = eval::litRegion(
       frame, {.patterns = patterns, .exactly = true, .smooth = true, .projector = projector});
+  for (int y = 0; y < m.height; ++y) {
+    for (int x = 0; x < m.width; ++x) {
+      if (x < kImageMarginPx || y < kImageMarginPx || x >= m.width - kImageMarginPx ||
+          y >= m.height - kImageMarginPx) {
+        m.at(x, y) = 0;
+      }
+    }
+  }
+  return m;
 }
 
 }  // namespace smx::test

@@ -28,8 +28,12 @@ struct DemuxedFrame {
                                                         const algo::DemuxParams& params = {},
                                                         double nominalDepthM = kTestNominalDepthM);
 
+// The band along the image's edges where the demultiplexer finds no boundaries by construction:
+// the 5-tap filters and the samples one pixel either side of a boundary need 4 px around it.
+inline constexpr int kImageMarginPx = 4;
+
 // Pixels lit by exactly `patterns` projectors, projector among them, 3 px inside that region and
-// away from depth jumps over 2 %.
+// away from depth jumps over 2 %, outside the image's margin band.
 [[nodiscard]] eval::Mask regionLitBy(const eval::SimFrame& frame, int projector, int patterns);
 
 }  // namespace smx::test

@@ -128,13 +128,14 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 // A sphere before a wall: curved surface, shadows, an occluding contour. Towards the sphere's rim
 // one pattern arrives at grazing incidence and fades: its lobe is lost there and the direction
 // is guessed from the tiles around, so the 95th percentile is far off target (ratchet: 15°);
-// recall is just under target for one projector (ratchet 97.5 %); the position error meets it.
+// recall, precision and position meet the targets, the class of one projector's boundaries is
+// just under (98.8 %, ratchet 98.5 %).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
   const auto f = render("rig_2proj_1cam.json", "sphere");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
-    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"),
-                 {1.0, 15.0, 0.975, 0.985, 0.985, 0.15}, "projector " + std::to_string(p));
+    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"), {1.0, 15.0, 0.98, 0.98, 0.985, 0.15},
+                 "projector " + std::to_string(p));
     expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.15},
                  "projector " + std::to_string(p) + " alone");
   }
