@@ -26,23 +26,46 @@ namespace {
 struct Figures {
   eval::BoundaryScore boundaries;
   eval::AngleStats directions;
+  eval::AngleStats directionsFound;  // where the pattern's lobe was found (nearest tile)
+  double foundShare = 0;             // of the region
 };
+
+// The region's pixels whose nearest tile found projector p's lobe.
+eval::Mask whereFound(const eval::Mask& region, const Demultiplexer& d, int p) {
+  eval::Mask m = region;
+  const int tilePx = d.layout().params.tilePx;
+  const auto tilesX = static_cast<std::size_t>(d.layout().tilesX());
+  for (int y = 0; y < m.height; ++y) {
+    for (int x = 0; x < m.width; ++x) {
+      const std::size_t t =
+          static_cast<std::size_t>(y / tilePx) * tilesX + static_cast<std::size_t>(x / tilePx);
+      if (d.tileDirections(p)[t].present == 0) {
+        m.at(x, y) = 0;
+      }
+    }
+  }
+  return m;
+}
 
 // Projector p's figures where exactly `patterns` projectors light the surface, p among them,
 // 3 px inside that region and away from depth jumps over 2 %.
 Figures measure(const eval::SimFrame& f, const Demultiplexer& d, int p, int patterns,
                 const std::string& label) {
   const eval::Mask region = test::regionLitBy(f, p, patterns);
-  Figures fig{eval::scoreBoundaries(d.boundaries(p), d.directions(p),
-                                    f.stripe[static_cast<std::size_t>(p)].view(), region.view()),
-              eval::scoreDirections(d.directions(p), f.stripe[static_cast<std::size_t>(p)].view(),
-                                    region.view())};
+  const eval::Mask found = whereFound(region, d, p);
+  const auto stripe = f.stripe[static_cast<std::size_t>(p)].view();
+  Figures fig{eval::scoreBoundaries(d.boundaries(p), d.directions(p), stripe, region.view()),
+              eval::scoreDirections(d.directions(p), stripe, region.view()),
+              eval::scoreDirections(d.directions(p), stripe, found.view()),
+              static_cast<double>(found.count()) / std::max(region.count(), 1)};
   const auto& b = fig.boundaries;
   std::printf(
-      "%-22s proj%d lit by %d: %6d px | direction median %.2f p95 %.2f deg | boundaries %6d "
-      "recall %.4f precision %.4f class %.4f position rms %.3f mean %+.3f px\n",
+      "%-22s proj%d lit by %d: %6d px | direction median %.2f p95 %.2f deg (lobe found in "
+      "%.1f %%: p95 %.2f) | boundaries %6d recall %.4f precision %.4f class %.4f position rms "
+      "%.3f mean %+.3f px\n",
       label.c_str(), p, patterns, region.count(), fig.directions.medianDeg, fig.directions.p95Deg,
-      b.trueBoundaries, b.recall, b.precision, b.classAccuracy, b.positionRmsPx, b.positionMeanPx);
+      100 * fig.foundShare, fig.directionsFound.p95Deg, b.trueBoundaries, b.recall, b.precision,
+      b.classAccuracy, b.positionRmsPx, b.positionMeanPx);
   return fig;
 }
 
@@ -126,16 +149,19 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 }
 
 // A sphere before a wall: curved surface, shadows, an occluding contour. Towards the sphere's rim
-// one pattern arrives at grazing incidence and fades: its lobe is lost there and the direction
-// is guessed from the tiles around, so the 95th percentile is far off target (ratchet: 15°);
+// one pattern arrives at grazing incidence and fades: its lobe is lost there (about 6 % of the
+// region) and the direction is guessed from the tiles around, so the 95th percentile is far off
+// target (ratchet: 15°) while it meets it where the lobe was found;
 // recall, precision and position meet the targets, the class of one projector's boundaries is
 // just under (98.8 %, ratchet 98.5 %).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
   const auto f = render("rig_2proj_1cam.json", "sphere");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
-    expectWithin(measure(f, *d->demux, p, 2, "sphere 90deg"), {1.0, 15.0, 0.98, 0.98, 0.985, 0.15},
-                 "projector " + std::to_string(p));
+    const Figures both = measure(f, *d->demux, p, 2, "sphere 90deg");
+    expectWithin(both, {1.0, 15.0, 0.98, 0.98, 0.985, 0.15}, "projector " + std::to_string(p));
+    EXPECT_LE(both.directionsFound.p95Deg, 5.0) << "projector " << p;
+    EXPECT_GE(both.foundShare, 0.9) << "projector " << p;
     expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.15},
                  "projector " + std::to_string(p) + " alone");
   }
