@@ -9,7 +9,9 @@
 //   Class: the rising channel is the colour after the boundary, the falling one the colour
 //   before. Confidence 255 · (1 − |2·n_third − n_to − n_from| / (n_to − n_from)).
 #include <algorithm>
+#include <bit>
 #include <cstdint>
+#include <cstring>
 
 #include "demux_kernels.hpp"
 
@@ -102,16 +104,6 @@ Response secondOrderResponse(const Response& behind, const Response& ahead) {
   return r;
 }
 
-std::int32_t strengthOf(const Response& r) {
-  std::int32_t hi = r.n[0];
-  std::int32_t lo = r.n[0];
-  for (const std::int32_t v : r.n) {
-    hi = v > hi ? v : hi;
-    lo = v < lo ? v : lo;
-  }
-  return hi - lo;
-}
-
 std::uint16_t saturateStrength(std::int32_t v) {
   return static_cast<std::uint16_t>(v > 65535 ? 65535 : v);
 }
@@ -164,39 +156,186 @@ std::int32_t zeroCrossingQ8(const SeparatedRow& row, const Boundary& b, int x,
 namespace {
 
 constexpr int kMargin = 3;    // responses and their neighbours stay inside the separated area
-constexpr int kChunkPx = 64;  // non-maximum suppression: pixels tested before the candidates
+constexpr int kChunkPx = 64;  // pixels per chunk of a row: taps, samples and maxima on the stack
 
-// One row of the strength plane: max − min over the channels of the response, 0 in the margin.
-void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
-                 ConstDirectionPlane direction, const UnitTable& units, int y, std::uint16_t* s) {
-  const int w = separated[0].width();
-  const std::uint8_t* o = order.rowPtr(y);
-  const std::uint16_t* d = direction.rowPtr(y);
-  const std::int16_t* v0 = separated[0].rowPtr(y);
-  const std::int16_t* v1 = separated[1].rowPtr(y);
-  const std::int16_t* v2 = separated[2].rowPtr(y);
-  // First-order pixels (most): max − min of the three planes, a branch-free loop; the
-  // second-order ones are then redone with their bilinear responses.
-  bool anySecond = false;
-  for (int x = kMargin; x < w - kMargin; ++x) {
-    const std::int32_t hi =
-        std::max({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
-    const std::int32_t lo =
-        std::min({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
-    s[x] = o[x] == 1 ? saturateStrength(hi - lo) : 0;
-    anySecond = anySecond || o[x] == 2;
-  }
-  if (!anySecond) {
-    return;
-  }
-  const SeparatedRow row(separated, y);
-  for (int x = kMargin; x < w - kMargin; ++x) {
-    if (o[x] == 2) {
-      const TapPair taps = tapsAlong(units.cosOf(d[x]), units.sinOf(d[x]), 6);
-      s[x] = saturateStrength(
-          strengthOf(secondOrderResponse(row.samples(x, taps.behind), row.samples(x, taps.ahead))));
+// The taps one pixel behind and ahead along the encoding direction for a chunk of a row, as
+// plain rows: per pixel the bilinear weights (256 − f, f) in x and y, and a code of the four
+// integer offsets. The direction field is smooth, so the code is constant over long runs, and
+// within a run every sample is shifted-row arithmetic that vectorises without gathers.
+struct TapWeights {
+  std::int16_t x0[kChunkPx];
+  std::int16_t x1[kChunkPx];
+  std::int16_t y1[kChunkPx];  // the y weights are 256 − y1 and y1
+};
+
+struct ChunkTaps {
+  TapWeights behind;
+  TapWeights ahead;
+  std::uint8_t offsets[kChunkPx];
+};
+
+// Integer offsets (behind dx, dy, ahead dx, dy), each in {−1, 0, 1}, two bits apiece.
+constexpr std::uint8_t offsetCode(std::int32_t bx, std::int32_t by, std::int32_t ax,
+                                  std::int32_t ay) {
+  return static_cast<std::uint8_t>((bx + 1) | ((by + 1) << 2) | ((ax + 1) << 4) | ((ay + 1) << 6));
+}
+
+struct RunOffsets {
+  int behindDx;
+  int behindDy;
+  int aheadDx;
+  int aheadDy;
+};
+
+constexpr RunOffsets offsetsOf(std::uint8_t code) {
+  return {(code & 3) - 1, ((code >> 2) & 3) - 1, ((code >> 4) & 3) - 1, ((code >> 6) & 3) - 1};
+}
+
+// The unit vector of each UnitTable entry in Q8 (Q1.14 >> 6): one lookup per pixel instead of
+// two; an angle's sine is the entry a quarter turn (256 entries) before its cosine.
+class UnitsQ8 {
+ public:
+  explicit UnitsQ8(const UnitTable& units) {
+    for (std::size_t i = 0; i < kEntries; ++i) {
+      const auto angle = static_cast<std::uint16_t>(i << 6U);
+      q8_[i] = {static_cast<std::int16_t>(units.cosOf(angle) >> 6),
+                static_cast<std::int16_t>(units.sinOf(angle) >> 6)};
     }
   }
+  struct Unit {
+    std::int16_t x;
+    std::int16_t y;
+  };
+  // UnitTable::cosOf's entry, rounded to the nearest.
+  [[nodiscard]] Unit of(std::uint16_t angle) const {
+    return q8_[((angle + 32U) >> 6U) & (kEntries - 1U)];
+  }
+
+ private:
+  static constexpr std::size_t kEntries = UnitTable::kEntries;
+  std::array<Unit, kEntries> q8_{};
+};
+
+// The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: a gather, then branch-free
+// arithmetic that vectorises.
+void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t) {
+  std::int16_t dxq[kChunkPx];
+  std::int16_t dyq[kChunkPx];
+  for (int i = 0; i < n; ++i) {
+    const UnitsQ8::Unit u = units.of(d[i]);
+    dxq[i] = u.x;
+    dyq[i] = u.y;
+  }
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t ax = dxq[i];
+    const std::int32_t ay = dyq[i];
+    t.ahead.x1[i] = static_cast<std::int16_t>(ax & 255);
+    t.ahead.y1[i] = static_cast<std::int16_t>(ay & 255);
+    t.behind.x1[i] = static_cast<std::int16_t>(-ax & 255);
+    t.behind.y1[i] = static_cast<std::int16_t>(-ay & 255);
+    t.ahead.x0[i] = static_cast<std::int16_t>(256 - t.ahead.x1[i]);
+    t.behind.x0[i] = static_cast<std::int16_t>(256 - t.behind.x1[i]);
+    t.offsets[i] = offsetCode((-ax) >> 8, (-ay) >> 8, ax >> 8, ay >> 8);
+  }
+}
+
+// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n).
+template <class F>
+void forEachRun(const ChunkTaps& t, int n, F&& f) {
+  for (int i0 = 0; i0 < n;) {
+    int i1 = i0 + 1;
+    while (i1 < n && t.offsets[i1] == t.offsets[i0]) {
+      ++i1;
+    }
+    f(i0, i1, offsetsOf(t.offsets[i0]));
+    i0 = i1;
+  }
+}
+
+// sampleAt's arithmetic for pixel i of a run: r0 points at the 2×2 corner of pixel 0, r1 one
+// row below.
+template <class T>
+std::int32_t bilinear(const T* r0, const T* r1, const TapWeights& t, int i) {
+  // The weights in T: products of two same-signed 16-bit values widen in one vector step.
+  const auto x0 = static_cast<T>(t.x0[i]);
+  const auto x1 = static_cast<T>(t.x1[i]);
+  const std::int32_t top = r0[i] * x0 + r0[i + 1] * x1;
+  const std::int32_t bottom = r1[i] * x0 + r1[i + 1] * x1;
+  // top · (256 − y1) + bottom · y1 with one 32-bit product
+  return ((top << 8) + (bottom - top) * t.y1[i] + 32768) >> 16;
+}
+
+template <class T>
+const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
+  return pixel0 + static_cast<std::ptrdiff_t>(dy) * stride + dx;
+}
+
+// Second-order response of one channel over a run: sample behind − sample ahead.
+void responseRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t,
+                 const RunOffsets& o, int i0, int i1, std::int32_t* out) {
+  const std::int16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
+  const std::int16_t* b1 = b0 + stride;
+  const std::int16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
+  const std::int16_t* a1 = a0 + stride;
+  for (int i = i0; i < i1; ++i) {
+    out[i] = bilinear(b0, b1, t.behind, i) - bilinear(a0, a1, t.ahead, i);
+  }
+}
+
+// One chunk [x0, x0 + n) of a strength row: max − min over the channels of the response, where
+// first-order pixels' response is the separated value and second-order ones' the bilinear
+// difference; 0 where the order is 0.
+void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::uint16_t* d,
+                   const UnitsQ8& units, int y, int x0, int n, std::uint16_t* s) {
+  const std::int16_t* v[3];
+  for (std::size_t c = 0; c < 3; ++c) {
+    v[c] = separated[c].rowPtr(y) + x0;
+  }
+  unsigned anySecond = 0;  // an OR, not ||: the loop vectorises
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t hi =
+        std::max({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+    const std::int32_t lo =
+        std::min({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+    s[i] = o[i] == 1 ? saturateStrength(hi - lo) : 0;
+    anySecond |= static_cast<unsigned>(o[i] == 2);
+  }
+  if (anySecond == 0) {
+    return;
+  }
+  ChunkTaps taps;
+  chunkTaps(d, units, n, taps);
+  std::int32_t response[3][kChunkPx];
+  forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      responseRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, response[c]);
+    }
+  });
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t hi = std::max({response[0][i], response[1][i], response[2][i]});
+    const std::int32_t lo = std::min({response[0][i], response[1][i], response[2][i]});
+    s[i] = o[i] == 2 ? saturateStrength(hi - lo) : s[i];
+  }
+}
+
+// Strength samples one pixel ahead and behind along the encoding direction over a chunk.
+struct ChunkSamples {
+  std::int32_t ahead[kChunkPx];
+  std::int32_t behind[kChunkPx];
+};
+
+void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t, int n,
+                     ChunkSamples& out) {
+  forEachRun(t, n, [&](int i0, int i1, const RunOffsets& o) {
+    const std::uint16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
+    const std::uint16_t* b1 = b0 + stride;
+    const std::uint16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
+    const std::uint16_t* a1 = a0 + stride;
+    for (int i = i0; i < i1; ++i) {
+      out.ahead[i] = bilinear(a0, a1, t.ahead, i);
+      out.behind[i] = bilinear(b0, b1, t.behind, i);
+    }
+  });
 }
 
 // Where the strength at x is at least the minimum and no less than the bilinear sample one pixel
@@ -206,28 +345,6 @@ struct Candidate {
   std::int32_t ahead;
   std::int32_t behind;
 };
-
-// The maxima of one row chunk [x0, x1) into `found`; returns their count. Whether a pixel is a
-// maximum is unpredictable, so every pixel takes both samples and is appended branch-free (the
-// sample positions are inside the plane whatever the strength); the costly rest of the test
-// runs on the candidates only.
-int maximaAlong(ImageView<const std::uint16_t> st, const std::uint16_t* d, const UnitTable& units,
-                int minStrength, int y, int x0, int x1, Candidate* found) {
-  const std::ptrdiff_t stride = strideOf(st);
-  const std::uint16_t* s = st.rowPtr(y);
-  int count = 0;
-  for (int x = x0; x < x1; ++x) {
-    const TapPair taps = tapsAlong(units.cosOf(d[x]), units.sinOf(d[x]), 6);
-    const std::int32_t s0 = s[x];
-    const std::int32_t ahead = sampleAt(s + x, stride, taps.ahead);
-    const std::int32_t behind = sampleAt(s + x, stride, taps.behind);
-    found[count] = {x, ahead, behind};
-    // Bitwise, not short-circuit: no branch to mispredict.
-    count += static_cast<int>(s0 >= minStrength) & static_cast<int>(s0 >= ahead) &
-             static_cast<int>(s0 > behind);
-  }
-  return count;
-}
 
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
 Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, std::uint8_t order,
@@ -266,6 +383,37 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   return found;
 }
 
+// Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
+// (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
+// the strength), then the costly rest on the maxima only, found eight flags at a time.
+void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, const std::uint8_t* o,
+                 const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
+                 int minStrength, int y, int x0, int n, Boundary* b) {
+  const std::uint16_t* s = st.rowPtr(y) + x0;
+  ChunkTaps taps;
+  chunkTaps(d + x0, units, n, taps);
+  ChunkSamples samples;
+  strengthSamples(s, strideOf(st), taps, n, samples);
+  alignas(8) std::uint8_t isMax[kChunkPx] = {};
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t s0 = s[i];
+    isMax[i] = static_cast<std::uint8_t>(static_cast<int>(s0 >= minStrength) &
+                                         static_cast<int>(s0 >= samples.ahead[i]) &
+                                         static_cast<int>(s0 > samples.behind[i]));
+  }
+  for (int i8 = 0; i8 < n; i8 += 8) {
+    std::uint64_t flags = 0;
+    std::memcpy(&flags, isMax + i8, sizeof flags);
+    while (flags != 0) {
+      const int i = i8 + std::countr_zero(flags) / 8;
+      flags &= flags - 1;
+      const int x = x0 + i;
+      b[x] = boundaryAt(row, st, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), y,
+                        {x, samples.ahead[i], samples.behind[i]});
+    }
+  }
+}
+
 }  // namespace
 
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
@@ -273,14 +421,21 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
                       ImageView<std::uint16_t> strength, BoundaryPlane out) {
   const int w = separated[0].width();
   const int h = separated[0].height();
+  const UnitsQ8 unitsQ8(units);
 
   for (int y = 0; y < h; ++y) {
     std::uint16_t* s = strength.rowPtr(y);
-    for (int x = 0; x < w; ++x) {
-      s[x] = 0;
+    if (y < kMargin || y >= h - kMargin) {
+      std::fill_n(s, w, std::uint16_t{0});
+      continue;
     }
-    if (y >= kMargin && y < h - kMargin) {
-      strengthRow(separated, order, direction, units, y, s);
+    std::fill_n(s, kMargin, std::uint16_t{0});
+    std::fill_n(s + w - kMargin, kMargin, std::uint16_t{0});
+    const std::uint8_t* o = order.rowPtr(y);
+    const std::uint16_t* d = direction.rowPtr(y);
+    for (int x0 = kMargin; x0 < w - kMargin; x0 += kChunkPx) {
+      const int n = std::min(kChunkPx, w - kMargin - x0);
+      strengthChunk(separated, o + x0, d + x0, unitsQ8, y, x0, n, s + x0);
     }
   }
 
@@ -289,9 +444,7 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
   const ImageView<const std::uint16_t> st = strength;
   for (int y = 0; y < h; ++y) {
     Boundary* b = out.rowPtr(y);
-    for (int x = 0; x < w; ++x) {
-      b[x] = Boundary{};
-    }
+    std::fill_n(b, w, Boundary{});
     if (y < kMargin + 1 || y >= h - kMargin - 1) {
       continue;
     }
@@ -299,13 +452,8 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
     const std::uint16_t* d = direction.rowPtr(y);
     const SeparatedRow row(separated, y);
     for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
-      const int x1 = std::min(x0 + kChunkPx, w - kMargin - 1);
-      Candidate candidates[kChunkPx];
-      const int count = maximaAlong(st, d, units, minStrength, y, x0, x1, candidates);
-      for (int i = 0; i < count; ++i) {
-        const int x = candidates[i].x;
-        b[x] = boundaryAt(row, st, o[x], units.cosOf(d[x]), units.sinOf(d[x]), y, candidates[i]);
-      }
+      const int n = std::min(kChunkPx, w - kMargin - 1 - x0);
+      maximaChunk(row, st, o, d, unitsQ8, units, minStrength, y, x0, n, b);
     }
   }
 }
