@@ -174,10 +174,12 @@ struct ChunkTaps {
   std::uint8_t offsets[kChunkPx];
 };
 
-// Integer offsets (behind dx, dy, ahead dx, dy), each in {−1, 0, 1}, two bits apiece.
-constexpr std::uint8_t offsetCode(std::int32_t bx, std::int32_t by, std::int32_t ax,
-                                  std::int32_t ay) {
-  return static_cast<std::uint8_t>((bx + 1) | ((by + 1) << 2) | ((ax + 1) << 4) | ((ay + 1) << 6));
+// The integer offsets of the Q8 taps (behind dx, dy, ahead dx, dy), each in {−1, 0, 1}, two
+// bits apiece.
+constexpr std::uint8_t offsetCode(std::int16_t bx, std::int16_t by, std::int16_t ax,
+                                  std::int16_t ay) {
+  const auto part = [](std::int16_t q8) { return static_cast<std::uint8_t>((q8 >> 8) + 1); };
+  return static_cast<std::uint8_t>(part(bx) | (part(by) << 2) | (part(ax) << 4) | (part(ay) << 6));
 }
 
 struct RunOffsets {
@@ -191,57 +193,65 @@ constexpr RunOffsets offsetsOf(std::uint8_t code) {
   return {(code & 3) - 1, ((code >> 2) & 3) - 1, ((code >> 4) & 3) - 1, ((code >> 6) & 3) - 1};
 }
 
-// The unit vector of each UnitTable entry in Q8 (Q1.14 >> 6): one lookup per pixel instead of
-// two; an angle's sine is the entry a quarter turn (256 entries) before its cosine.
+// The unit vector of each UnitTable entry in Q8 (Q1.14 >> 6), x in the low and y in the high
+// half: one lookup per pixel instead of two; an angle's sine is the entry a quarter turn (256
+// entries) before its cosine.
 class UnitsQ8 {
  public:
+  static constexpr std::size_t kEntries = UnitTable::kEntries;
+
   explicit UnitsQ8(const UnitTable& units) {
     for (std::size_t i = 0; i < kEntries; ++i) {
       const auto angle = static_cast<std::uint16_t>(i << 6U);
-      q8_[i] = {static_cast<std::int16_t>(units.cosOf(angle) >> 6),
-                static_cast<std::int16_t>(units.sinOf(angle) >> 6)};
+      const auto x = static_cast<std::uint16_t>(units.cosOf(angle) >> 6);
+      const auto y = static_cast<std::uint16_t>(units.sinOf(angle) >> 6);
+      q8_[i] = x | (std::uint32_t{y} << 16U);
     }
   }
-  struct Unit {
-    std::int16_t x;
-    std::int16_t y;
-  };
-  // UnitTable::cosOf's entry, rounded to the nearest.
-  [[nodiscard]] Unit of(std::uint16_t angle) const {
-    return q8_[((angle + 32U) >> 6U) & (kEntries - 1U)];
-  }
+  [[nodiscard]] std::uint32_t operator[](std::uint16_t entry) const { return q8_[entry]; }
 
  private:
-  static constexpr std::size_t kEntries = UnitTable::kEntries;
-  std::array<Unit, kEntries> q8_{};
+  std::array<std::uint32_t, kEntries> q8_{};
 };
 
-// The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: a gather, then branch-free
-// arithmetic that vectorises.
+// The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: UnitTable's entries (rounded to the
+// nearest) and the arithmetic in loops that vectorise around the one gather.
 void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t) {
-  std::int16_t dxq[kChunkPx];
-  std::int16_t dyq[kChunkPx];
+  std::uint16_t entry[kChunkPx];
   for (int i = 0; i < n; ++i) {
-    const UnitsQ8::Unit u = units.of(d[i]);
-    dxq[i] = u.x;
-    dyq[i] = u.y;
+    // 16-bit wrap-around: the carry out of the sum is masked off by the entry count anyway.
+    const auto rounded = static_cast<std::uint16_t>(d[i] + 32U);
+    entry[i] = static_cast<std::uint16_t>((rounded >> 6U) & (UnitsQ8::kEntries - 1U));
+  }
+  std::uint32_t unit[kChunkPx];
+  for (int i = 0; i < n; ++i) {
+    unit[i] = units[entry[i]];
   }
   for (int i = 0; i < n; ++i) {
-    const std::int32_t ax = dxq[i];
-    const std::int32_t ay = dyq[i];
+    const auto ax = static_cast<std::int16_t>(unit[i]);
+    const auto ay = static_cast<std::int16_t>(unit[i] >> 16U);
     t.ahead.x1[i] = static_cast<std::int16_t>(ax & 255);
     t.ahead.y1[i] = static_cast<std::int16_t>(ay & 255);
     t.behind.x1[i] = static_cast<std::int16_t>(-ax & 255);
     t.behind.y1[i] = static_cast<std::int16_t>(-ay & 255);
     t.ahead.x0[i] = static_cast<std::int16_t>(256 - t.ahead.x1[i]);
     t.behind.x0[i] = static_cast<std::int16_t>(256 - t.behind.x1[i]);
-    t.offsets[i] = offsetCode((-ax) >> 8, (-ay) >> 8, ax >> 8, ay >> 8);
+    t.offsets[i] =
+        offsetCode(static_cast<std::int16_t>(-ax), static_cast<std::int16_t>(-ay), ax, ay);
   }
 }
 
-// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n).
+// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n); mostly one run.
 template <class F>
 void forEachRun(const ChunkTaps& t, int n, F&& f) {
+  unsigned differs = 0;
+  for (int i = 0; i < n; ++i) {
+    differs |= static_cast<unsigned>(t.offsets[i] ^ t.offsets[0]);
+  }
+  if (differs == 0) {
+    f(0, n, offsetsOf(t.offsets[0]));
+    return;
+  }
   for (int i0 = 0; i0 < n;) {
     int i1 = i0 + 1;
     while (i1 < n && t.offsets[i1] == t.offsets[i0]) {
