@@ -393,6 +393,17 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   return found;
 }
 
+// The index of the lowest-addressed nonzero byte of a word loaded from memory, and the word
+// without it, whatever the byte order.
+int firstByte(std::uint64_t word) {
+  return std::endian::native == std::endian::little ? std::countr_zero(word) / 8
+                                                    : std::countl_zero(word) / 8;
+}
+std::uint64_t withoutByte(std::uint64_t word, int byte) {
+  const int shift = std::endian::native == std::endian::little ? 8 * byte : 56 - 8 * byte;
+  return word & ~(std::uint64_t{0xFF} << shift);
+}
+
 // Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
 // (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
 // the strength), then the costly rest on the maxima only, found eight flags at a time.
@@ -415,8 +426,9 @@ void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, con
     std::uint64_t flags = 0;
     std::memcpy(&flags, isMax + i8, sizeof flags);
     while (flags != 0) {
-      const int i = i8 + std::countr_zero(flags) / 8;
-      flags &= flags - 1;
+      const int byte = firstByte(flags);
+      flags = withoutByte(flags, byte);
+      const int i = i8 + byte;
       const int x = x0 + i;
       b[x] = boundaryAt(row, st, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), y,
                         {x, samples.ahead[i], samples.behind[i]});
