@@ -301,14 +301,23 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   for (std::size_t c = 0; c < 3; ++c) {
     v[c] = separated[c].rowPtr(y) + x0;
   }
-  unsigned anySecond = 0;  // an OR, not ||: the loop vectorises
+  // ORs, not ||: the loops vectorise. Chunks are mostly of one order.
+  unsigned anyFirst = 0;
+  unsigned anySecond = 0;
   for (int i = 0; i < n; ++i) {
-    const std::int32_t hi =
-        std::max({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
-    const std::int32_t lo =
-        std::min({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
-    s[i] = o[i] == 1 ? saturateStrength(hi - lo) : 0;
+    anyFirst |= static_cast<unsigned>(o[i] == 1);
     anySecond |= static_cast<unsigned>(o[i] == 2);
+  }
+  if (anyFirst == 0) {
+    std::fill_n(s, n, std::uint16_t{0});
+  } else {
+    for (int i = 0; i < n; ++i) {
+      const std::int32_t hi =
+          std::max({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+      const std::int32_t lo =
+          std::min({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+      s[i] = o[i] == 1 ? saturateStrength(hi - lo) : 0;
+    }
   }
   if (anySecond == 0) {
     return;
