@@ -155,8 +155,8 @@ std::int32_t zeroCrossingQ8(const SeparatedRow& row, const Boundary& b, int x,
 
 namespace {
 
-constexpr int kMargin = 3;    // responses and their neighbours stay inside the separated area
-constexpr int kChunkPx = 64;  // pixels per chunk of a row: taps, samples and maxima on the stack
+constexpr int kMargin = 3;     // responses and their neighbours stay inside the separated area
+constexpr int kChunkPx = 128;  // pixels per chunk of a row: taps, samples and maxima on the stack
 
 // The taps one pixel behind and ahead along the encoding direction for a chunk of a row, as
 // plain rows: per pixel the bilinear weights (256 − f, f) in x and y, and a code of the four
