@@ -280,23 +280,52 @@ const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
   return pixel0 + static_cast<std::ptrdiff_t>(dy) * stride + dx;
 }
 
-// Second-order response of one channel over a run: sample behind − sample ahead.
-void responseRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t,
-                 const RunOffsets& o, int i0, int i1, std::int32_t* out) {
+// One channel's samples behind and ahead over a run.
+void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t,
+                const RunOffsets& o, int i0, int i1, std::int16_t* behind, std::int16_t* ahead) {
   const std::int16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
   const std::int16_t* b1 = b0 + stride;
   const std::int16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
   const std::int16_t* a1 = a0 + stride;
   for (int i = i0; i < i1; ++i) {
-    out[i] = bilinear(b0, b1, t.behind, i) - bilinear(a0, a1, t.ahead, i);
+    // A bilinear sample lies between its corners' values: int16.
+    behind[i] = static_cast<std::int16_t>(bilinear(b0, b1, t.behind, i));
+    ahead[i] = static_cast<std::int16_t>(bilinear(a0, a1, t.ahead, i));
   }
 }
+
+// The second-order samples (behind per channel, then ahead per channel) of the last rows the
+// strength pass computed, kept for the maxima found three rows later, in the output plane's
+// last rows, which are written only after every row kept here is done with: row y's six int16
+// rows fill three Boundary rows, slot y mod 4. Rows too near the bottom are not kept (their
+// maxima sample again), nor anything when the image is too small.
+class SampleRing {
+ public:
+  static constexpr int kSlots = 4;
+  static constexpr int kRows = kSlots * 3;
+
+  explicit SampleRing(BoundaryPlane out) : out_(out) {}
+
+  [[nodiscard]] bool holds(int y) const { return y < out_.height() - kRows; }
+  // Sample j (0–5) of pixel x of row y.
+  [[nodiscard]] std::byte* at(int y, int j, int x) const {
+    const int index = (y % kSlots) * 6 + j;
+    auto* row = reinterpret_cast<std::byte*>(out_.rowPtr(out_.height() - kRows + index / 2));
+    const auto half = static_cast<std::size_t>(out_.width()) * sizeof(std::int16_t);
+    return row + static_cast<std::size_t>(index % 2) * half +
+           static_cast<std::size_t>(x) * sizeof(std::int16_t);
+  }
+
+ private:
+  BoundaryPlane out_;
+};
 
 // One chunk [x0, x0 + n) of a strength row: max − min over the channels of the response, where
 // first-order pixels' response is the separated value and second-order ones' the bilinear
 // difference; 0 where the order is 0.
 void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::uint16_t* d,
-                   const UnitsQ8& units, int y, int x0, int n, std::uint16_t* s) {
+                   const UnitsQ8& units, const SampleRing& ring, int y, int x0, int n,
+                   std::uint16_t* s) {
   const std::int16_t* v[3];
   for (std::size_t c = 0; c < 3; ++c) {
     v[c] = separated[c].rowPtr(y) + x0;
@@ -324,16 +353,25 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   }
   ChunkTaps taps;
   chunkTaps(d, units, n, taps);
-  std::int32_t response[3][kChunkPx];
+  std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
   forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
     for (std::size_t c = 0; c < 3; ++c) {
-      responseRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, response[c]);
+      samplesRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, samples[c], samples[3 + c]);
     }
   });
   for (int i = 0; i < n; ++i) {
-    const std::int32_t hi = std::max({response[0][i], response[1][i], response[2][i]});
-    const std::int32_t lo = std::min({response[0][i], response[1][i], response[2][i]});
+    const std::int32_t n0 = samples[0][i] - samples[3][i];
+    const std::int32_t n1 = samples[1][i] - samples[4][i];
+    const std::int32_t n2 = samples[2][i] - samples[5][i];
+    const std::int32_t hi = std::max({n0, n1, n2});
+    const std::int32_t lo = std::min({n0, n1, n2});
     s[i] = o[i] == 2 ? saturateStrength(hi - lo) : s[i];
+  }
+  if (ring.holds(y)) {
+    for (int j = 0; j < 6; ++j) {
+      std::memcpy(ring.at(y, j, x0), samples[j],
+                  static_cast<std::size_t>(n) * sizeof(std::int16_t));
+    }
   }
 }
 
@@ -365,9 +403,16 @@ struct Candidate {
   std::int32_t behind;
 };
 
+std::int32_t kept(const std::byte* sample) {
+  std::int16_t v = 0;
+  std::memcpy(&v, sample, sizeof v);
+  return v;
+}
+
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
 Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, std::uint8_t order,
-                    std::int32_t ux, std::int32_t uy, int y, const Candidate& c) {
+                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
+                    const Candidate& c) {
   const int w = st.width();
   const int h = st.height();
   const int x = c.x;
@@ -390,9 +435,19 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   if (order == 1) {
     found = classify({{row.value(0, x), row.value(1, x), row.value(2, x)}});
   } else {
-    const TapPair taps = tapsAlong(ux, uy, 6);
-    const Response behindSamples = row.samples(x, taps.behind);
-    const Response aheadSamples = row.samples(x, taps.ahead);
+    Response behindSamples{};
+    Response aheadSamples{};
+    if (ring.holds(y)) {
+      for (int channel = 0; channel < 3; ++channel) {
+        const auto k = static_cast<std::size_t>(channel);
+        behindSamples.n[k] = kept(ring.at(y, channel, x));
+        aheadSamples.n[k] = kept(ring.at(y, 3 + channel, x));
+      }
+    } else {
+      const TapPair taps = tapsAlong(ux, uy, 6);
+      behindSamples = row.samples(x, taps.behind);
+      aheadSamples = row.samples(x, taps.ahead);
+    }
     found = classify(secondOrderResponse(behindSamples, aheadSamples));
     if (order == 2) {
       offset = zeroCrossingQ8(row, found, x, behindSamples, aheadSamples, parabola);
@@ -418,7 +473,7 @@ std::uint64_t withoutByte(std::uint64_t word, int byte) {
 // the strength), then the costly rest on the maxima only, found eight flags at a time.
 void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, const std::uint8_t* o,
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
-                 int minStrength, int y, int x0, int n, Boundary* b) {
+                 const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
   const std::uint16_t* s = st.rowPtr(y) + x0;
   ChunkTaps taps;
   chunkTaps(d + x0, units, n, taps);
@@ -439,7 +494,7 @@ void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, con
       flags = withoutByte(flags, byte);
       const int i = i8 + byte;
       const int x = x0 + i;
-      b[x] = boundaryAt(row, st, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), y,
+      b[x] = boundaryAt(row, st, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), ring, y,
                         {x, samples.ahead[i], samples.behind[i]});
     }
   }
@@ -447,44 +502,72 @@ void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, con
 
 }  // namespace
 
+namespace {
+
+// Row y of the strength plane.
+void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
+                 ConstDirectionPlane direction, const UnitsQ8& units, const SampleRing& ring, int y,
+                 ImageView<std::uint16_t> strength) {
+  const int w = separated[0].width();
+  const int h = separated[0].height();
+  std::uint16_t* s = strength.rowPtr(y);
+  if (y < kMargin || y >= h - kMargin) {
+    std::fill_n(s, w, std::uint16_t{0});
+    return;
+  }
+  std::fill_n(s, kMargin, std::uint16_t{0});
+  std::fill_n(s + w - kMargin, kMargin, std::uint16_t{0});
+  const std::uint8_t* o = order.rowPtr(y);
+  const std::uint16_t* d = direction.rowPtr(y);
+  for (int x0 = kMargin; x0 < w - kMargin; x0 += kChunkPx) {
+    const int n = std::min(kChunkPx, w - kMargin - x0);
+    strengthChunk(separated, o + x0, d + x0, units, ring, y, x0, n, s + x0);
+  }
+}
+
+// Row y of the boundaries: non-maximum suppression one pixel inside the margin (its samples
+// stay in the strength plane's computed area).
+void maximaRow(const Planes3& separated, ImageView<const std::uint8_t> order,
+               ConstDirectionPlane direction, const UnitsQ8& unitsQ8, const UnitTable& units,
+               const SampleRing& ring, int minStrength, ImageView<const std::uint16_t> st, int y,
+               BoundaryPlane out) {
+  const int w = separated[0].width();
+  const int h = separated[0].height();
+  Boundary* b = out.rowPtr(y);
+  std::fill_n(b, w, Boundary{});
+  if (y < kMargin + 1 || y >= h - kMargin - 1) {
+    return;
+  }
+  const std::uint8_t* o = order.rowPtr(y);
+  const std::uint16_t* d = direction.rowPtr(y);
+  const SeparatedRow row(separated, y);
+  for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
+    const int n = std::min(kChunkPx, w - kMargin - 1 - x0);
+    maximaChunk(row, st, o, d, unitsQ8, units, ring, minStrength, y, x0, n, b);
+  }
+}
+
+// Row y's maxima read the strength up to row y + 3 (the 2×2 of a sample two pixels below).
+constexpr int kStrengthAhead = 3;
+static_assert(kStrengthAhead < SampleRing::kSlots);
+
+}  // namespace
+
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
                       ConstDirectionPlane direction, const UnitTable& units, int minStrength,
                       ImageView<std::uint16_t> strength, BoundaryPlane out) {
-  const int w = separated[0].width();
   const int h = separated[0].height();
   const UnitsQ8 unitsQ8(units);
-
-  for (int y = 0; y < h; ++y) {
-    std::uint16_t* s = strength.rowPtr(y);
-    if (y < kMargin || y >= h - kMargin) {
-      std::fill_n(s, w, std::uint16_t{0});
-      continue;
+  const SampleRing ring(out);
+  // Row by row, the maxima kStrengthAhead rows behind the strength, while the samples they
+  // reuse are still in the ring (and the rows in cache).
+  for (int y = 0; y < h + kStrengthAhead; ++y) {
+    if (y < h) {
+      strengthRow(separated, order, direction, unitsQ8, ring, y, strength);
     }
-    std::fill_n(s, kMargin, std::uint16_t{0});
-    std::fill_n(s + w - kMargin, kMargin, std::uint16_t{0});
-    const std::uint8_t* o = order.rowPtr(y);
-    const std::uint16_t* d = direction.rowPtr(y);
-    for (int x0 = kMargin; x0 < w - kMargin; x0 += kChunkPx) {
-      const int n = std::min(kChunkPx, w - kMargin - x0);
-      strengthChunk(separated, o + x0, d + x0, unitsQ8, y, x0, n, s + x0);
-    }
-  }
-
-  // Non-maximum suppression, one pixel inside the margin (its samples stay in the strength
-  // plane's computed area).
-  const ImageView<const std::uint16_t> st = strength;
-  for (int y = 0; y < h; ++y) {
-    Boundary* b = out.rowPtr(y);
-    std::fill_n(b, w, Boundary{});
-    if (y < kMargin + 1 || y >= h - kMargin - 1) {
-      continue;
-    }
-    const std::uint8_t* o = order.rowPtr(y);
-    const std::uint16_t* d = direction.rowPtr(y);
-    const SeparatedRow row(separated, y);
-    for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
-      const int n = std::min(kChunkPx, w - kMargin - 1 - x0);
-      maximaChunk(row, st, o, d, unitsQ8, units, minStrength, y, x0, n, b);
+    if (y >= kStrengthAhead) {
+      maximaRow(separated, order, direction, unitsQ8, units, ring, minStrength, strength,
+                y - kStrengthAhead, out);
     }
   }
 }
