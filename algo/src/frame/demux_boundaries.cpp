@@ -10,6 +10,7 @@
 //   before. Confidence 255 · (1 − |2·n_third − n_to − n_from| / (n_to − n_from)).
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 
