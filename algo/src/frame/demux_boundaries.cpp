@@ -404,6 +404,7 @@ struct Candidate {
   std::int32_t behind;
 };
 
+// A sample kept in the ring: bytes of the Boundary plane, so read by memcpy, not through a cast.
 std::int32_t kept(const std::byte* sample) {
   std::int16_t v = 0;
   std::memcpy(&v, sample, sizeof v);
