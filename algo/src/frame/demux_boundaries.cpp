@@ -9,7 +9,10 @@
 //   Class: the rising channel is the colour after the boundary, the falling one the colour
 //   before. Confidence 255 · (1 − |2·n_third − n_to − n_from| / (n_to − n_from)).
 #include <algorithm>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "demux_kernels.hpp"
 
@@ -102,16 +105,6 @@ Response secondOrderResponse(const Response& behind, const Response& ahead) {
   return r;
 }
 
-std::int32_t strengthOf(const Response& r) {
-  std::int32_t hi = r.n[0];
-  std::int32_t lo = r.n[0];
-  for (const std::int32_t v : r.n) {
-    hi = v > hi ? v : hi;
-    lo = v < lo ? v : lo;
-  }
-  return hi - lo;
-}
-
 std::uint16_t saturateStrength(std::int32_t v) {
   return static_cast<std::uint16_t>(v > 65535 ? 65535 : v);
 }
@@ -163,40 +156,244 @@ std::int32_t zeroCrossingQ8(const SeparatedRow& row, const Boundary& b, int x,
 
 namespace {
 
-constexpr int kMargin = 3;    // responses and their neighbours stay inside the separated area
-constexpr int kChunkPx = 64;  // non-maximum suppression: pixels tested before the candidates
+constexpr int kMargin = 3;     // responses and their neighbours stay inside the separated area
+constexpr int kChunkPx = 128;  // pixels per chunk of a row: taps, samples and maxima on the stack
 
-// One row of the strength plane: max − min over the channels of the response, 0 in the margin.
-void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
-                 ConstDirectionPlane direction, const UnitTable& units, int y, std::uint16_t* s) {
-  const int w = separated[0].width();
-  const std::uint8_t* o = order.rowPtr(y);
-  const std::uint16_t* d = direction.rowPtr(y);
-  const std::int16_t* v0 = separated[0].rowPtr(y);
-  const std::int16_t* v1 = separated[1].rowPtr(y);
-  const std::int16_t* v2 = separated[2].rowPtr(y);
-  // First-order pixels (most): max − min of the three planes, a branch-free loop; the
-  // second-order ones are then redone with their bilinear responses.
-  bool anySecond = false;
-  for (int x = kMargin; x < w - kMargin; ++x) {
-    const std::int32_t hi =
-        std::max({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
-    const std::int32_t lo =
-        std::min({std::int32_t{v0[x]}, std::int32_t{v1[x]}, std::int32_t{v2[x]}});
-    s[x] = o[x] == 1 ? saturateStrength(hi - lo) : 0;
-    anySecond = anySecond || o[x] == 2;
-  }
-  if (!anySecond) {
-    return;
-  }
-  const SeparatedRow row(separated, y);
-  for (int x = kMargin; x < w - kMargin; ++x) {
-    if (o[x] == 2) {
-      const TapPair taps = tapsAlong(units.cosOf(d[x]), units.sinOf(d[x]), 6);
-      s[x] = saturateStrength(
-          strengthOf(secondOrderResponse(row.samples(x, taps.behind), row.samples(x, taps.ahead))));
+// The taps one pixel behind and ahead along the encoding direction for a chunk of a row, as
+// plain rows: per pixel the bilinear weights (256 − f, f) in x and y, and a code of the four
+// integer offsets. The direction field is smooth, so the code is constant over long runs, and
+// within a run every sample is shifted-row arithmetic that vectorises without gathers.
+struct TapWeights {
+  std::int16_t x0[kChunkPx];
+  std::int16_t x1[kChunkPx];
+  std::int16_t y1[kChunkPx];  // the y weights are 256 − y1 and y1
+};
+
+struct ChunkTaps {
+  TapWeights behind;
+  TapWeights ahead;
+  std::uint8_t offsets[kChunkPx];
+};
+
+// The integer offsets of the Q8 taps (behind dx, dy, ahead dx, dy), each in {−1, 0, 1}, two
+// bits apiece.
+constexpr std::uint8_t offsetCode(std::int16_t bx, std::int16_t by, std::int16_t ax,
+                                  std::int16_t ay) {
+  const auto part = [](std::int16_t q8) { return static_cast<std::uint8_t>((q8 >> 8) + 1); };
+  return static_cast<std::uint8_t>(part(bx) | (part(by) << 2) | (part(ax) << 4) | (part(ay) << 6));
+}
+
+struct RunOffsets {
+  int behindDx;
+  int behindDy;
+  int aheadDx;
+  int aheadDy;
+};
+
+constexpr RunOffsets offsetsOf(std::uint8_t code) {
+  return {(code & 3) - 1, ((code >> 2) & 3) - 1, ((code >> 4) & 3) - 1, ((code >> 6) & 3) - 1};
+}
+
+// The unit vector of each UnitTable entry in Q8 (Q1.14 >> 6), x in the low and y in the high
+// half: one lookup per pixel instead of two; an angle's sine is the entry a quarter turn (256
+// entries) before its cosine.
+class UnitsQ8 {
+ public:
+  static constexpr std::size_t kEntries = UnitTable::kEntries;
+
+  explicit UnitsQ8(const UnitTable& units) {
+    for (std::size_t i = 0; i < kEntries; ++i) {
+      const auto angle = static_cast<std::uint16_t>(i << 6U);
+      const auto x = static_cast<std::uint16_t>(units.cosOf(angle) >> 6);
+      const auto y = static_cast<std::uint16_t>(units.sinOf(angle) >> 6);
+      q8_[i] = x | (std::uint32_t{y} << 16U);
     }
   }
+  [[nodiscard]] std::uint32_t operator[](std::uint16_t entry) const { return q8_[entry]; }
+
+ private:
+  std::array<std::uint32_t, kEntries> q8_{};
+};
+
+// The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: UnitTable's entries (rounded to the
+// nearest) and the arithmetic in loops that vectorise around the one gather.
+void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t) {
+  std::uint16_t entry[kChunkPx];
+  for (int i = 0; i < n; ++i) {
+    // 16-bit wrap-around: the carry out of the sum is masked off by the entry count anyway.
+    const auto rounded = static_cast<std::uint16_t>(d[i] + 32U);
+    entry[i] = static_cast<std::uint16_t>((rounded >> 6U) & (UnitsQ8::kEntries - 1U));
+  }
+  std::uint32_t unit[kChunkPx];
+  for (int i = 0; i < n; ++i) {
+    unit[i] = units[entry[i]];
+  }
+  for (int i = 0; i < n; ++i) {
+    const auto ax = static_cast<std::int16_t>(unit[i]);
+    const auto ay = static_cast<std::int16_t>(unit[i] >> 16U);
+    t.ahead.x1[i] = static_cast<std::int16_t>(ax & 255);
+    t.ahead.y1[i] = static_cast<std::int16_t>(ay & 255);
+    t.behind.x1[i] = static_cast<std::int16_t>(-ax & 255);
+    t.behind.y1[i] = static_cast<std::int16_t>(-ay & 255);
+    t.ahead.x0[i] = static_cast<std::int16_t>(256 - t.ahead.x1[i]);
+    t.behind.x0[i] = static_cast<std::int16_t>(256 - t.behind.x1[i]);
+    t.offsets[i] =
+        offsetCode(static_cast<std::int16_t>(-ax), static_cast<std::int16_t>(-ay), ax, ay);
+  }
+}
+
+// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n); mostly one run.
+template <class F>
+void forEachRun(const ChunkTaps& t, int n, F&& f) {
+  unsigned differs = 0;
+  for (int i = 0; i < n; ++i) {
+    differs |= static_cast<unsigned>(t.offsets[i] ^ t.offsets[0]);
+  }
+  if (differs == 0) {
+    f(0, n, offsetsOf(t.offsets[0]));
+    return;
+  }
+  for (int i0 = 0; i0 < n;) {
+    int i1 = i0 + 1;
+    while (i1 < n && t.offsets[i1] == t.offsets[i0]) {
+      ++i1;
+    }
+    f(i0, i1, offsetsOf(t.offsets[i0]));
+    i0 = i1;
+  }
+}
+
+// sampleAt's arithmetic for pixel i of a run: r0 points at the 2×2 corner of pixel 0, r1 one
+// row below.
+template <class T>
+std::int32_t bilinear(const T* r0, const T* r1, const TapWeights& t, int i) {
+  // The weights in T: products of two same-signed 16-bit values widen in one vector step.
+  const auto x0 = static_cast<T>(t.x0[i]);
+  const auto x1 = static_cast<T>(t.x1[i]);
+  const std::int32_t top = r0[i] * x0 + r0[i + 1] * x1;
+  const std::int32_t bottom = r1[i] * x0 + r1[i + 1] * x1;
+  // top · (256 − y1) + bottom · y1 with one 32-bit product
+  return ((top << 8) + (bottom - top) * t.y1[i] + 32768) >> 16;
+}
+
+template <class T>
+const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
+  return pixel0 + static_cast<std::ptrdiff_t>(dy) * stride + dx;
+}
+
+// One channel's samples behind and ahead over a run.
+void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t,
+                const RunOffsets& o, int i0, int i1, std::int16_t* behind, std::int16_t* ahead) {
+  const std::int16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
+  const std::int16_t* b1 = b0 + stride;
+  const std::int16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
+  const std::int16_t* a1 = a0 + stride;
+  for (int i = i0; i < i1; ++i) {
+    // A bilinear sample lies between its corners' values: int16.
+    behind[i] = static_cast<std::int16_t>(bilinear(b0, b1, t.behind, i));
+    ahead[i] = static_cast<std::int16_t>(bilinear(a0, a1, t.ahead, i));
+  }
+}
+
+// The second-order samples (behind per channel, then ahead per channel) of the last rows the
+// strength pass computed, kept for the maxima found three rows later, in the output plane's
+// last rows, which are written only after every row kept here is done with: row y's six int16
+// rows fill three Boundary rows, slot y mod 4. Rows too near the bottom are not kept (their
+// maxima sample again), nor anything when the image is too small.
+class SampleRing {
+ public:
+  static constexpr int kSlots = 4;
+  static constexpr int kRows = kSlots * 3;
+
+  explicit SampleRing(BoundaryPlane out) : out_(out) {}
+
+  [[nodiscard]] bool holds(int y) const { return y < out_.height() - kRows; }
+  // Sample j (0–5) of pixel x of row y.
+  [[nodiscard]] std::byte* at(int y, int j, int x) const {
+    const int index = (y % kSlots) * 6 + j;
+    auto* row = reinterpret_cast<std::byte*>(out_.rowPtr(out_.height() - kRows + index / 2));
+    const auto half = static_cast<std::size_t>(out_.width()) * sizeof(std::int16_t);
+    return row + static_cast<std::size_t>(index % 2) * half +
+           static_cast<std::size_t>(x) * sizeof(std::int16_t);
+  }
+
+ private:
+  BoundaryPlane out_;
+};
+
+// One chunk [x0, x0 + n) of a strength row: max − min over the channels of the response, where
+// first-order pixels' response is the separated value and second-order ones' the bilinear
+// difference; 0 where the order is 0.
+void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::uint16_t* d,
+                   const UnitsQ8& units, const SampleRing& ring, int y, int x0, int n,
+                   std::uint16_t* s) {
+  const std::int16_t* v[3];
+  for (std::size_t c = 0; c < 3; ++c) {
+    v[c] = separated[c].rowPtr(y) + x0;
+  }
+  // ORs, not ||: the loops vectorise. Chunks are mostly of one order.
+  unsigned anyFirst = 0;
+  unsigned anySecond = 0;
+  for (int i = 0; i < n; ++i) {
+    anyFirst |= static_cast<unsigned>(o[i] == 1);
+    anySecond |= static_cast<unsigned>(o[i] == 2);
+  }
+  if (anyFirst == 0) {
+    std::fill_n(s, n, std::uint16_t{0});
+  } else {
+    for (int i = 0; i < n; ++i) {
+      const std::int32_t hi =
+          std::max({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+      const std::int32_t lo =
+          std::min({std::int32_t{v[0][i]}, std::int32_t{v[1][i]}, std::int32_t{v[2][i]}});
+      s[i] = o[i] == 1 ? saturateStrength(hi - lo) : 0;
+    }
+  }
+  if (anySecond == 0) {
+    return;
+  }
+  ChunkTaps taps;
+  chunkTaps(d, units, n, taps);
+  std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
+  forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      samplesRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, samples[c], samples[3 + c]);
+    }
+  });
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t n0 = samples[0][i] - samples[3][i];
+    const std::int32_t n1 = samples[1][i] - samples[4][i];
+    const std::int32_t n2 = samples[2][i] - samples[5][i];
+    const std::int32_t hi = std::max({n0, n1, n2});
+    const std::int32_t lo = std::min({n0, n1, n2});
+    s[i] = o[i] == 2 ? saturateStrength(hi - lo) : s[i];
+  }
+  if (ring.holds(y)) {
+    for (int j = 0; j < 6; ++j) {
+      std::memcpy(ring.at(y, j, x0), samples[j],
+                  static_cast<std::size_t>(n) * sizeof(std::int16_t));
+    }
+  }
+}
+
+// Strength samples one pixel ahead and behind along the encoding direction over a chunk.
+struct ChunkSamples {
+  std::int32_t ahead[kChunkPx];
+  std::int32_t behind[kChunkPx];
+};
+
+void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t, int n,
+                     ChunkSamples& out) {
+  forEachRun(t, n, [&](int i0, int i1, const RunOffsets& o) {
+    const std::uint16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
+    const std::uint16_t* b1 = b0 + stride;
+    const std::uint16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
+    const std::uint16_t* a1 = a0 + stride;
+    for (int i = i0; i < i1; ++i) {
+      out.ahead[i] = bilinear(a0, a1, t.ahead, i);
+      out.behind[i] = bilinear(b0, b1, t.behind, i);
+    }
+  });
 }
 
 // Where the strength at x is at least the minimum and no less than the bilinear sample one pixel
@@ -207,31 +404,17 @@ struct Candidate {
   std::int32_t behind;
 };
 
-// The maxima of one row chunk [x0, x1) into `found`; returns their count. Whether a pixel is a
-// maximum is unpredictable, so every pixel takes both samples and is appended branch-free (the
-// sample positions are inside the plane whatever the strength); the costly rest of the test
-// runs on the candidates only.
-int maximaAlong(ImageView<const std::uint16_t> st, const std::uint16_t* d, const UnitTable& units,
-                int minStrength, int y, int x0, int x1, Candidate* found) {
-  const std::ptrdiff_t stride = strideOf(st);
-  const std::uint16_t* s = st.rowPtr(y);
-  int count = 0;
-  for (int x = x0; x < x1; ++x) {
-    const TapPair taps = tapsAlong(units.cosOf(d[x]), units.sinOf(d[x]), 6);
-    const std::int32_t s0 = s[x];
-    const std::int32_t ahead = sampleAt(s + x, stride, taps.ahead);
-    const std::int32_t behind = sampleAt(s + x, stride, taps.behind);
-    found[count] = {x, ahead, behind};
-    // Bitwise, not short-circuit: no branch to mispredict.
-    count += static_cast<int>(s0 >= minStrength) & static_cast<int>(s0 >= ahead) &
-             static_cast<int>(s0 > behind);
-  }
-  return count;
+// A sample kept in the ring: bytes of the Boundary plane, so read by memcpy, not through a cast.
+std::int32_t kept(const std::byte* sample) {
+  std::int16_t v = 0;
+  std::memcpy(&v, sample, sizeof v);
+  return v;
 }
 
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
 Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, std::uint8_t order,
-                    std::int32_t ux, std::int32_t uy, int y, const Candidate& c) {
+                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
+                    const Candidate& c) {
   const int w = st.width();
   const int h = st.height();
   const int x = c.x;
@@ -254,9 +437,19 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   if (order == 1) {
     found = classify({{row.value(0, x), row.value(1, x), row.value(2, x)}});
   } else {
-    const TapPair taps = tapsAlong(ux, uy, 6);
-    const Response behindSamples = row.samples(x, taps.behind);
-    const Response aheadSamples = row.samples(x, taps.ahead);
+    Response behindSamples{};
+    Response aheadSamples{};
+    if (ring.holds(y)) {
+      for (int channel = 0; channel < 3; ++channel) {
+        const auto k = static_cast<std::size_t>(channel);
+        behindSamples.n[k] = kept(ring.at(y, channel, x));
+        aheadSamples.n[k] = kept(ring.at(y, 3 + channel, x));
+      }
+    } else {
+      const TapPair taps = tapsAlong(ux, uy, 6);
+      behindSamples = row.samples(x, taps.behind);
+      aheadSamples = row.samples(x, taps.ahead);
+    }
     found = classify(secondOrderResponse(behindSamples, aheadSamples));
     if (order == 2) {
       offset = zeroCrossingQ8(row, found, x, behindSamples, aheadSamples, parabola);
@@ -266,46 +459,117 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   return found;
 }
 
+// The index of the lowest-addressed nonzero byte of a word loaded from memory, and the word
+// without it, whatever the byte order.
+int firstByte(std::uint64_t word) {
+  return std::endian::native == std::endian::little ? std::countr_zero(word) / 8
+                                                    : std::countl_zero(word) / 8;
+}
+std::uint64_t withoutByte(std::uint64_t word, int byte) {
+  const int shift = std::endian::native == std::endian::little ? 8 * byte : 56 - 8 * byte;
+  return word & ~(std::uint64_t{0xFF} << shift);
+}
+
+// Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
+// (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
+// the strength), then the costly rest on the maxima only, found eight flags at a time.
+void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, const std::uint8_t* o,
+                 const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
+                 const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
+  const std::uint16_t* s = st.rowPtr(y) + x0;
+  ChunkTaps taps;
+  chunkTaps(d + x0, units, n, taps);
+  ChunkSamples samples;
+  strengthSamples(s, strideOf(st), taps, n, samples);
+  alignas(8) std::uint8_t isMax[kChunkPx] = {};
+  for (int i = 0; i < n; ++i) {
+    const std::int32_t s0 = s[i];
+    isMax[i] = static_cast<std::uint8_t>(static_cast<int>(s0 >= minStrength) &
+                                         static_cast<int>(s0 >= samples.ahead[i]) &
+                                         static_cast<int>(s0 > samples.behind[i]));
+  }
+  for (int i8 = 0; i8 < n; i8 += 8) {
+    std::uint64_t flags = 0;
+    std::memcpy(&flags, isMax + i8, sizeof flags);
+    while (flags != 0) {
+      const int byte = firstByte(flags);
+      flags = withoutByte(flags, byte);
+      const int i = i8 + byte;
+      const int x = x0 + i;
+      b[x] = boundaryAt(row, st, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), ring, y,
+                        {x, samples.ahead[i], samples.behind[i]});
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Row y of the strength plane.
+void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
+                 ConstDirectionPlane direction, const UnitsQ8& units, const SampleRing& ring, int y,
+                 ImageView<std::uint16_t> strength) {
+  const int w = separated[0].width();
+  const int h = separated[0].height();
+  std::uint16_t* s = strength.rowPtr(y);
+  if (y < kMargin || y >= h - kMargin) {
+    std::fill_n(s, w, std::uint16_t{0});
+    return;
+  }
+  std::fill_n(s, kMargin, std::uint16_t{0});
+  std::fill_n(s + w - kMargin, kMargin, std::uint16_t{0});
+  const std::uint8_t* o = order.rowPtr(y);
+  const std::uint16_t* d = direction.rowPtr(y);
+  for (int x0 = kMargin; x0 < w - kMargin; x0 += kChunkPx) {
+    const int n = std::min(kChunkPx, w - kMargin - x0);
+    strengthChunk(separated, o + x0, d + x0, units, ring, y, x0, n, s + x0);
+  }
+}
+
+// Row y of the boundaries: non-maximum suppression one pixel inside the margin (its samples
+// stay in the strength plane's computed area).
+void maximaRow(const Planes3& separated, ImageView<const std::uint8_t> order,
+               ConstDirectionPlane direction, const UnitsQ8& unitsQ8, const UnitTable& units,
+               const SampleRing& ring, int minStrength, ImageView<const std::uint16_t> st, int y,
+               BoundaryPlane out) {
+  const int w = separated[0].width();
+  const int h = separated[0].height();
+  Boundary* b = out.rowPtr(y);
+  std::fill_n(b, w, Boundary{});
+  if (y < kMargin + 1 || y >= h - kMargin - 1) {
+    return;
+  }
+  const std::uint8_t* o = order.rowPtr(y);
+  const std::uint16_t* d = direction.rowPtr(y);
+  const SeparatedRow row(separated, y);
+  for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
+    const int n = std::min(kChunkPx, w - kMargin - 1 - x0);
+    maximaChunk(row, st, o, d, unitsQ8, units, ring, minStrength, y, x0, n, b);
+  }
+}
+
+// Row y's maxima read the strength up to row y + 3 (the 2×2 of a sample two pixels below).
+constexpr int kStrengthAhead = 3;
+static_assert(kStrengthAhead < SampleRing::kSlots);
+
 }  // namespace
 
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
                       ConstDirectionPlane direction, const UnitTable& units, int minStrength,
                       ImageView<std::uint16_t> strength, BoundaryPlane out) {
-  const int w = separated[0].width();
   const int h = separated[0].height();
-
-  for (int y = 0; y < h; ++y) {
-    std::uint16_t* s = strength.rowPtr(y);
-    for (int x = 0; x < w; ++x) {
-      s[x] = 0;
+  const UnitsQ8 unitsQ8(units);
+  const SampleRing ring(out);
+  // Row by row, the maxima kStrengthAhead rows behind the strength, while the samples they
+  // reuse are still in the ring (and the rows in cache).
+  for (int y = 0; y < h + kStrengthAhead; ++y) {
+    if (y < h) {
+      strengthRow(separated, order, direction, unitsQ8, ring, y, strength);
     }
-    if (y >= kMargin && y < h - kMargin) {
-      strengthRow(separated, order, direction, units, y, s);
-    }
-  }
-
-  // Non-maximum suppression, one pixel inside the margin (its samples stay in the strength
-  // plane's computed area).
-  const ImageView<const std::uint16_t> st = strength;
-  for (int y = 0; y < h; ++y) {
-    Boundary* b = out.rowPtr(y);
-    for (int x = 0; x < w; ++x) {
-      b[x] = Boundary{};
-    }
-    if (y < kMargin + 1 || y >= h - kMargin - 1) {
-      continue;
-    }
-    const std::uint8_t* o = order.rowPtr(y);
-    const std::uint16_t* d = direction.rowPtr(y);
-    const SeparatedRow row(separated, y);
-    for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
-      const int x1 = std::min(x0 + kChunkPx, w - kMargin - 1);
-      Candidate candidates[kChunkPx];
-      const int count = maximaAlong(st, d, units, minStrength, y, x0, x1, candidates);
-      for (int i = 0; i < count; ++i) {
-        const int x = candidates[i].x;
-        b[x] = boundaryAt(row, st, o[x], units.cosOf(d[x]), units.sinOf(d[x]), y, candidates[i]);
-      }
+    if (y >= kStrengthAhead) {
+      maximaRow(separated, order, direction, unitsQ8, units, ring, minStrength, strength,
+                y - kStrengthAhead, out);
     }
   }
 }
