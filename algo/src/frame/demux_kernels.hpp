@@ -112,7 +112,7 @@ class RowBlock {
 // separate()'s rows: a ring of horizontally filtered rows (int32; 5 rows × 3 channels × 3
 // filters) and the current row's derivatives, unit vectors and tile data (int16).
 inline constexpr std::size_t kFilterRows = 45;
-inline constexpr std::size_t kWorkRows = 38;
+inline constexpr std::size_t kWorkRows = 39;
 
 // The signed difference a − b of two BinAngle raw values, wrapped into [−2^15, 2^15).
 [[nodiscard]] inline std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {

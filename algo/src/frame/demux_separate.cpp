@@ -18,6 +18,7 @@
 //   int16 into int32, which the vector units do natively. The steering runs per span of pixels
 //   whose nearest tiles hold the same other patterns, in branch-free loops that GCC vectorises.
 #include <algorithm>
+#include <array>
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -39,7 +40,7 @@ constexpr std::size_t filterRowIndex(int slot, int channel, int filter) {
 // The int16 working rows: the current row's derivatives per channel, every projector's unit
 // vectors along it, the tile colour per channel and pixel, and per tile row and projector which
 // other patterns each tile column holds; then the tile runs (first pixel and tile of each) and
-// one projector's steering results.
+// which derivative orders each tile column needs; then one projector's steering results.
 enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
 constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
   return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
@@ -58,7 +59,8 @@ constexpr std::size_t othersRowIndex(int projector) {
 }
 constexpr std::size_t kRunStartRow = kOthersRows + kMaxProjectors;
 constexpr std::size_t kRunTileRow = kRunStartRow + 1;
-constexpr std::size_t kSteerRows = kRunTileRow + 1;  // D per channel, then cxx, cxy, cyy
+constexpr std::size_t kNeedsRow = kRunTileRow + 1;
+constexpr std::size_t kSteerRows = kNeedsRow + 1;  // D per channel, then cxx, cxy, cyy
 static_assert(kWorkRows == kSteerRows + 6);
 
 // The horizontal prefilter and first derivative of one row of one channel, for x in [2, w − 3].
@@ -81,47 +83,72 @@ void filterRowSecond(const std::int16_t* s, int w, std::int32_t* d2) {
   }
 }
 
-// The vertical halves over rows y − 2 … y + 2 for a whole row, scaled by 2^-kRowShift into int16
-// (the rows and the output never overlap: restrict lets the loops vectorise).
+// The vertical halves over rows y − 2 … y + 2 for x in [x0, x1), scaled by 2^-kRowShift into
+// int16 (the rows and the output never overlap: restrict lets the loops vectorise).
 constexpr int kRowShift = 13;
 
-void verticalSmoothed(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int w) {
+void verticalSmoothed(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                      int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r1 = rows[1];
   const std::int32_t* __restrict r2 = rows[2];
   const std::int32_t* __restrict r3 = rows[3];
   const std::int32_t* __restrict r4 = rows[4];
-  for (int x = 2; x + 2 < w; ++x) {
+  for (int x = x0; x < x1; ++x) {
     out[x] = static_cast<std::int16_t>(
         (kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x]) >> kRowShift);
   }
 }
 
-void verticalDerivative(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int w) {
+void verticalDerivative(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                        int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r1 = rows[1];
   const std::int32_t* __restrict r3 = rows[3];
   const std::int32_t* __restrict r4 = rows[4];
-  for (int x = 2; x + 2 < w; ++x) {
+  for (int x = x0; x < x1; ++x) {
     out[x] = static_cast<std::int16_t>((kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x])) >>
                                        kRowShift);
   }
 }
 
-void verticalSecond(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int w) {
+void verticalSecond(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                    int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r2 = rows[2];
   const std::int32_t* __restrict r4 = rows[4];
-  for (int x = 2; x + 2 < w; ++x) {
+  for (int x = x0; x < x1; ++x) {
     out[x] = static_cast<std::int16_t>((kD2[0] * (r0[x] + r4[x]) + kD2[2] * r2[x]) >> kRowShift);
   }
 }
 
-void lookUpUnits(const std::uint16_t* angles, const UnitTable& units, int w, std::int16_t* cosRow,
+// The unit table's cos and sin of each entry in one word (cos low, sin high), so that a pixel's
+// unit vector takes one scalar load (lookups do not vectorise).
+constexpr std::uint32_t kUnitStep = 65536 / UnitTable::kEntries;
+
+struct PackedUnits {
+  std::array<std::uint32_t, UnitTable::kEntries> entries{};
+
+  explicit PackedUnits(const UnitTable& units) {
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const auto angle = static_cast<std::uint16_t>(i * kUnitStep);
+      entries[i] = static_cast<std::uint16_t>(units.cosOf(angle)) |
+                   static_cast<std::uint32_t>(static_cast<std::uint16_t>(units.sinOf(angle)))
+                       << 16U;
+    }
+  }
+  // The nearest entry, as UnitTable takes it.
+  [[nodiscard]] std::uint32_t of(std::uint16_t angle) const {
+    return entries[((angle + kUnitStep / 2) / kUnitStep) % UnitTable::kEntries];
+  }
+};
+
+void lookUpUnits(const std::uint16_t* angles, const PackedUnits& units, int w, std::int16_t* cosRow,
                  std::int16_t* sinRow) {
   for (int x = 2; x + 2 < w; ++x) {
-    cosRow[x] = static_cast<std::int16_t>(units.cosOf(angles[x]));
-    sinRow[x] = static_cast<std::int16_t>(units.sinOf(angles[x]));
+    const std::uint32_t both = units.of(angles[x]);
+    cosRow[x] = static_cast<std::int16_t>(both & 0xffffU);
+    sinRow[x] = static_cast<std::int16_t>(both >> 16U);
   }
 }
 
@@ -319,19 +346,17 @@ TileRuns findRuns(std::span<const TileInterp> columns, int w, std::int16_t* star
 }
 
 // Per tile row: which other projectors each projector's nearest tile holds (bit q: projector q's
-// pattern is present), whether some tile needs the first or the second derivatives, and the
-// tile colour spread over the row's pixels.
-struct TileRowCases {
-  bool needFirst = false;
-  bool needSecond = false;
-};
+// pattern is present), and which derivative orders each tile column needs over all projectors.
+constexpr int kNeedFirst = 1;
+constexpr int kNeedSecond = 2;
 
-TileRowCases classifyTileRow(std::span<const TileDirection> tiles, const DemuxLayout& layout,
-                             int tileRow, const RowBlock<std::int16_t>& work) {
+void classifyTileRow(std::span<const TileDirection> tiles, const DemuxLayout& layout, int tileRow,
+                     const RowBlock<std::int16_t>& work) {
   const int tilesX = layout.tilesX();
   const std::size_t tileCount = layout.tileCount();
   const std::size_t rowStart = static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(tilesX);
-  TileRowCases cases;
+  std::int16_t* needs = work.row(kNeedsRow);
+  std::fill(needs, needs + tilesX, std::int16_t{0});
   for (int p = 0; p < layout.projectors; ++p) {
     std::int16_t* others = work.row(othersRowIndex(p));
     for (int tx = 0; tx < tilesX; ++tx) {
@@ -346,10 +371,27 @@ TileRowCases classifyTileRow(std::span<const TileDirection> tiles, const DemuxLa
         }
       }
       others[tx] = static_cast<std::int16_t>(bits);
-      (count < 2 ? cases.needFirst : cases.needSecond) = true;
+      needs[tx] = static_cast<std::int16_t>(needs[tx] | (count < 2 ? kNeedFirst : kNeedSecond));
     }
   }
-  return cases;
+}
+
+// Calls f(x0, x1) for each longest span of runs whose tile columns need the order.
+template <class F>
+void forSpansNeeding(const TileRuns& runs, const std::int16_t* needs, int order, F&& f) {
+  int k = 0;
+  while (k < runs.runs) {
+    if ((needs[runs.tiles[k]] & order) == 0) {
+      ++k;
+      continue;
+    }
+    int end = k + 1;
+    while (end < runs.runs && (needs[runs.tiles[end]] & order) != 0) {
+      ++end;
+    }
+    f(runs.starts[k], runs.starts[end]);
+    k = end;
+  }
 }
 
 void spreadTileColour(std::span<const std::uint32_t> inverseColour, const DemuxLayout& layout,
@@ -463,7 +505,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
   for (int q = 0; q < projectors; ++q) {
     unitRows[q] = {work.row(unitRowIndex(q, 0)), work.row(unitRowIndex(q, 1))};
   }
-  TileRowCases cases;
+  const PackedUnits packedUnits(units);
   int casesRow = -1;
 
   for (int y = 0; y < h; ++y) {
@@ -479,12 +521,12 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
     }
     const int tileRow = rows[static_cast<std::size_t>(y)].nearest;
     if (tileRow != casesRow) {
-      cases = classifyTileRow(tiles, layout, tileRow, work);
+      classifyTileRow(tiles, layout, tileRow, work);
       spreadTileColour(inverseColour, layout, tileRow, runs, work);
       casesRow = tileRow;
     }
-    // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel, for the
-    // whole row; only the derivatives some pixel of the row steers.
+    // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel; only the
+    // derivatives some pixel steers, where it does.
     for (std::size_t c = 0; c < 3; ++c) {
       const std::int32_t* pre[5] = {};
       const std::int32_t* d1[5] = {};
@@ -495,18 +537,19 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
         d1[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 1));
         d2[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 2));
       }
-      if (cases.needFirst) {
-        verticalSmoothed(d1, work.row(derivativeRowIndex(c, kGx)), w);
-        verticalDerivative(pre, work.row(derivativeRowIndex(c, kGy)), w);
-      }
-      if (cases.needSecond) {
-        verticalSmoothed(d2, work.row(derivativeRowIndex(c, kHxx)), w);
-        verticalSecond(pre, work.row(derivativeRowIndex(c, kHyy)), w);
-        verticalDerivative(d1, work.row(derivativeRowIndex(c, kHxy)), w);
-      }
+      const std::int16_t* needs = work.row(kNeedsRow);
+      forSpansNeeding(runs, needs, kNeedFirst, [&](int x0, int x1) {
+        verticalSmoothed(d1, work.row(derivativeRowIndex(c, kGx)), x0, x1);
+        verticalDerivative(pre, work.row(derivativeRowIndex(c, kGy)), x0, x1);
+      });
+      forSpansNeeding(runs, needs, kNeedSecond, [&](int x0, int x1) {
+        verticalSmoothed(d2, work.row(derivativeRowIndex(c, kHxx)), x0, x1);
+        verticalSecond(pre, work.row(derivativeRowIndex(c, kHyy)), x0, x1);
+        verticalDerivative(d1, work.row(derivativeRowIndex(c, kHxy)), x0, x1);
+      });
     }
     for (int q = 0; q < projectors; ++q) {
-      lookUpUnits(directions[static_cast<std::size_t>(q)].rowPtr(y), units, w,
+      lookUpUnits(directions[static_cast<std::size_t>(q)].rowPtr(y), packedUnits, w,
                   work.row(unitRowIndex(q, 0)), work.row(unitRowIndex(q, 1)));
     }
     for (int p = 0; p < projectors; ++p) {
