@@ -294,28 +294,22 @@ void normaliseRow(const SteerRow& r, const ColourRows& colour, std::int32_t minC
   const std::int16_t* d0 = r.d[0];
   const std::int16_t* d1 = r.d[1];
   const std::int16_t* d2 = r.d[2];
-  std::int16_t* keep = r.cxx;  // free again
+  const auto scale = [](std::int16_t d, std::int16_t high, std::int16_t low) {
+    const std::int32_t scaled =
+        (d * high + ((d * low) >> kInverseSplit)) >> (kNormShift - kInverseSplit);
+    const std::int32_t upper = scaled > 32767 ? 32767 : scaled;
+    return static_cast<std::int16_t>(upper < -32768 ? -32768 : upper);
+  };
 #pragma GCC ivdep
   for (int x = 2; x + 2 < w; ++x) {
     const std::int16_t hi01 = d0[x] > d1[x] ? d0[x] : d1[x];
     const std::int16_t lo01 = d0[x] < d1[x] ? d0[x] : d1[x];
     const std::int16_t hi = hi01 > d2[x] ? hi01 : d2[x];
     const std::int16_t lo = lo01 < d2[x] ? lo01 : d2[x];
-    keep[x] = hi - lo >= minContrast ? std::int16_t{-1} : std::int16_t{0};
-  }
-  for (std::size_t c = 0; c < 3; ++c) {
-    const std::int16_t* d = r.d[c];
-    const std::int16_t* high = colour.high[c];
-    const std::int16_t* low = colour.low[c];
-    std::int16_t* o = out[c];
-#pragma GCC ivdep
-    for (int x = 2; x + 2 < w; ++x) {
-      const std::int32_t scaled =
-          (d[x] * high[x] + ((d[x] * low[x]) >> kInverseSplit)) >> (kNormShift - kInverseSplit);
-      const std::int32_t upper = scaled > 32767 ? 32767 : scaled;
-      const std::int32_t saturated = upper < -32768 ? -32768 : upper;
-      o[x] = static_cast<std::int16_t>(static_cast<std::int16_t>(saturated) & keep[x]);
-    }
+    const std::int16_t keep = hi - lo >= minContrast ? std::int16_t{-1} : std::int16_t{0};
+    out[0][x] = static_cast<std::int16_t>(scale(d0[x], colour.high[0][x], colour.low[0][x]) & keep);
+    out[1][x] = static_cast<std::int16_t>(scale(d1[x], colour.high[1][x], colour.low[1][x]) & keep);
+    out[2][x] = static_cast<std::int16_t>(scale(d2[x], colour.high[2][x], colour.low[2][x]) & keep);
   }
 }
 
