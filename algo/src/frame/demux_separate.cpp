@@ -264,16 +264,18 @@ void steerMixed(const SteerRow& r, UnitRows own, UnitRows first, UnitRows second
     cyy[x] = static_cast<std::int16_t>((flip ? -yy : yy) >> kUnitShift);
     cxy[x] = static_cast<std::int16_t>((flip ? xy : -xy) >> kUnitShift);
   }
-  for (std::size_t c = 0; c < 3; ++c) {
-    const std::int16_t* hxx = r.hxx[c];
-    const std::int16_t* hxy = r.hxy[c];
-    const std::int16_t* hyy = r.hyy[c];
-    std::int16_t* d = r.d[c];
+  const auto mixed = [](std::int16_t xx, std::int16_t xy, std::int16_t yy, std::int16_t hxx,
+                        std::int16_t hxy, std::int16_t hyy) {
+    return static_cast<std::int16_t>((xx * hxx + xy * hxy + yy * hyy) >> kSteerShift);
+  };
+  std::int16_t* d0 = r.d[0];
+  std::int16_t* d1 = r.d[1];
+  std::int16_t* d2 = r.d[2];
 #pragma GCC ivdep
-    for (int x = x0; x < x1; ++x) {
-      d[x] = static_cast<std::int16_t>((cxx[x] * hxx[x] + cxy[x] * hxy[x] + cyy[x] * hyy[x]) >>
-                                       kSteerShift);
-    }
+  for (int x = x0; x < x1; ++x) {
+    d0[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[0][x], r.hxy[0][x], r.hyy[0][x]);
+    d1[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[1][x], r.hxy[1][x], r.hyy[1][x]);
+    d2[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[2][x], r.hxy[2][x], r.hyy[2][x]);
   }
 }
 
