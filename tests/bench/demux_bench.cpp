@@ -143,10 +143,10 @@ class Stages {
         tileScratch_(layout.tileCount()),
         columns_(static_cast<std::size_t>(w_)),
         rows_(static_cast<std::size_t>(h_)),
-        filterMemory_(kern::RowBlock::valuesFor(kern::kFilterRows, w_)),
+        filterMemory_(kern::RowBlock<std::int32_t>::valuesFor(kern::kFilterRows, w_)),
         filterRows_(filterMemory_, w_),
-        derivativeMemory_(kern::RowBlock::valuesFor(kern::kDerivativeRows, w_)),
-        derivativeRows_(derivativeMemory_, w_),
+        workMemory_(kern::RowBlock<std::int16_t>::valuesFor(kern::kWorkRows, w_)),
+        workRows_(workMemory_, w_),
         strength_(pixelsOf(w_, h_)),
         minStrength_(kern::minStrengthQ11(layout.params)) {
     units_.fill();
@@ -158,6 +158,8 @@ class Stages {
     }
     for (std::size_t p = 0; p < projectors_.size(); ++p) {
       directionPlanes_[p] = viewOf(std::span(projectors_[p].direction), w_, h_);
+      separatedPlanes_[p] = projectors_[p].separated.views;
+      orderPlanes_[p] = viewOf(std::span(projectors_[p].order), w_, h_);
     }
   }
 
@@ -179,12 +181,10 @@ class Stages {
     kern::interpolateDirections(layout_, tileDirections_, columns_, rows_, directionPlanes());
   }
   void separate() {
-    for (int p = 0; p < layout_.projectors; ++p) {
-      ProjectorOut& out = projectors_[static_cast<std::size_t>(p)];
-      kern::separate(smoothed_.views, layout_, p, tileDirections_, tileInverse_, columns_, rows_,
-                     units_, filterRows_, derivativeRows_, directionPlanes(), out.separated.views,
-                     viewOf(std::span(out.order), w_, h_));
-    }
+    kern::separate(smoothed_.views, layout_, tileDirections_, tileInverse_, columns_, rows_, units_,
+                   filterRows_, workRows_, directionPlanes(),
+                   std::span(separatedPlanes_).first(projectors_.size()),
+                   std::span(orderPlanes_).first(projectors_.size()));
   }
   void boundaries() {
     for (ProjectorOut& out : projectors_) {
@@ -242,12 +242,14 @@ class Stages {
   std::vector<kern::TileInterp> rows_;
   kern::UnitTable units_;
   std::vector<std::int32_t> filterMemory_;
-  kern::RowBlock filterRows_;
-  std::vector<std::int32_t> derivativeMemory_;
-  kern::RowBlock derivativeRows_;
+  kern::RowBlock<std::int32_t> filterRows_;
+  std::vector<std::int16_t> workMemory_;
+  kern::RowBlock<std::int16_t> workRows_;
   std::vector<std::uint16_t> strength_;
   std::vector<ProjectorOut> projectors_;
   std::array<algo::DirectionPlane, algo::kMaxProjectors> directionPlanes_{};
+  std::array<kern::Planes3, algo::kMaxProjectors> separatedPlanes_{};
+  std::array<algo::ImageView<std::uint8_t>, algo::kMaxProjectors> orderPlanes_{};
   int minStrength_;
 
   [[nodiscard]] std::span<const algo::DirectionPlane> directionPlanes() const {

@@ -66,9 +66,10 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(carveSpan(carver, columns_, static_cast<std::size_t>(l.width)));
   step(carveSpan(carver, rows_, static_cast<std::size_t>(l.height)));
   step(carveSpan(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
-  step(carveSpan(carver, filterRows_, demux::RowBlock::valuesFor(demux::kFilterRows, l.width)));
-  step(carveSpan(carver, derivativeRows_,
-                 demux::RowBlock::valuesFor(demux::kDerivativeRows, l.width)));
+  step(carveSpan(carver, filterRows_,
+                 demux::RowBlock<std::int32_t>::valuesFor(demux::kFilterRows, l.width)));
+  step(carveSpan(carver, workRows_,
+                 demux::RowBlock<std::int16_t>::valuesFor(demux::kWorkRows, l.width)));
   step(carveSpan(carver, tileHistograms_, tiles * demux::kBins));
   step(carveSpan(carver, tileMoments_, tiles * demux::kBins));
   step(carveSpan(carver, tileColourSums_, tiles * 3));
@@ -78,12 +79,16 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   for (auto& plane : smoothed_) {
     step(carveImage(carver, plane, l.width, l.height));
   }
-  for (auto& plane : separated_) {
-    step(carveImage(carver, plane, l.width, l.height));
+  // The last projector's separated planes take smoothed_'s memory: 3 planes less.
+  separated_[projectors - 1] = smoothed_;
+  for (std::size_t p = 0; p + 1 < projectors; ++p) {
+    for (auto& plane : separated_[p]) {
+      step(carveImage(carver, plane, l.width, l.height));
+    }
   }
   step(carveImage(carver, strength_, l.width, l.height));
-  step(carveImage(carver, order_, l.width, l.height));
   for (std::size_t p = 0; p < projectors; ++p) {
+    step(carveImage(carver, order_[p], l.width, l.height));
     step(carveImage(carver, boundaries_[p], l.width, l.height));
     step(carveImage(carver, directions_[p], l.width, l.height));
   }
@@ -141,15 +146,21 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
     demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
                               tileScratch_);
   }
-  demux::interpolateDirections(
-      layout_, tileDirections_, columns_, rows_,
-      std::span<const DirectionPlane>(directions_.data(),
-                                      static_cast<std::size_t>(layout_.projectors)));
-  for (int projector = 0; projector < layout_.projectors; ++projector) {
-    if (auto ok = separateOnly(projector); !ok) {
-      return ok;
-    }
+  const auto projectors = static_cast<std::size_t>(layout_.projectors);
+  demux::interpolateDirections(layout_, tileDirections_, columns_, rows_,
+                               std::span<const DirectionPlane>(directions_.data(), projectors));
+  // Every projector separated in one sweep (the derivatives are shared), then its boundaries.
+  demux::separate(smoothed_, layout_, tileDirections_, tileInverseColour_, columns_, rows_,
+                  units_[0], demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
+                  demux::RowBlock<std::int16_t>(workRows_, layout_.width),
+                  std::span<const DirectionPlane>(directions_.data(), projectors),
+                  std::span<const demux::Planes3>(separated_.data(), projectors),
+                  std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
+  for (std::size_t q = 0; q < projectors; ++q) {
+    demux::detectBoundaries(separated_[q], order_[q], directions_[q], units_[0],
+                            demux::minStrengthQ11(p), strength_, boundaries_[q]);
   }
+  shownProjector_ = layout_.projectors - 1;
   return {};
 }
 
@@ -167,16 +178,7 @@ Result<void> Demultiplexer::separateOnly(int projector) {
   if (projector < 0 || projector >= layout_.projectors) {
     return fail(Errc::kInvalidArgument, "demux: no such projector");
   }
-  const auto p = static_cast<std::size_t>(projector);
-  const demux::RowBlock filtered(filterRows_, layout_.width);
-  const demux::RowBlock derivs(derivativeRows_, layout_.width);
-  demux::separate(smoothed_, layout_, projector, tileDirections_, tileInverseColour_, columns_,
-                  rows_, units_[0], filtered, derivs,
-                  std::span<const DirectionPlane>(directions_.data(),
-                                                  static_cast<std::size_t>(layout_.projectors)),
-                  separated_, order_);
-  demux::detectBoundaries(separated_, order_, directions_[p], units_[0],
-                          demux::minStrengthQ11(layout_.params), strength_, boundaries_[p]);
+  shownProjector_ = projector;
   return {};
 }
 
@@ -194,7 +196,7 @@ std::span<const TileDirection> Demultiplexer::tileDirections(int projector) cons
 }
 
 ImageView<const std::int16_t> Demultiplexer::separated(int channel) const {
-  return separated_[static_cast<std::size_t>(channel)];
+  return separated_[static_cast<std::size_t>(shownProjector_)][static_cast<std::size_t>(channel)];
 }
 
 }  // namespace smx::algo

@@ -92,45 +92,27 @@ struct TileInterp {
 };
 void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
 
-// Rows of int32 values of one width, carved from the arena: separate()'s working rows.
+// Rows of values of one width, carved from the arena: separate()'s working rows.
+template <class T>
 class RowBlock {
  public:
   RowBlock() = default;
-  RowBlock(std::span<std::int32_t> memory, int width)
+  RowBlock(std::span<T> memory, int width)
       : memory_(memory), width_(static_cast<std::size_t>(width)) {}
   [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
     return rows * static_cast<std::size_t>(width);
   }
-  [[nodiscard]] std::int32_t* row(std::size_t index) const {
-    return memory_.data() + index * width_;
-  }
+  [[nodiscard]] T* row(std::size_t index) const { return memory_.data() + index * width_; }
 
  private:
-  std::span<std::int32_t> memory_;
+  std::span<T> memory_;
   std::size_t width_ = 0;
 };
 
-// The ring of horizontally filtered rows separate() streams through: 5 slots (rows y − 2 … y + 2)
-// × 3 channels × (prefilter, first, second derivative).
-inline constexpr int kFilterSlots = 5;
-inline constexpr std::size_t kFilterRows = std::size_t{kFilterSlots} * 3 * 3;
-[[nodiscard]] constexpr std::size_t filterRowIndex(int slot, int channel, int filter) {
-  return (static_cast<std::size_t>(slot) * 3 + static_cast<std::size_t>(channel)) * 3 +
-         static_cast<std::size_t>(filter);
-}
-
-// The derivatives of the current row separate() steers from, per channel: gx, gy, hxx, hyy, hxy;
-// then every projector's unit vectors (cos, sin; Q1.14) along the current row.
-enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
-inline constexpr std::size_t kDerivativeRows =
-    std::size_t{3} * kDerivativeKinds + std::size_t{2} * kMaxProjectors;
-[[nodiscard]] constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
-  return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
-}
-[[nodiscard]] constexpr std::size_t unitRowIndex(int projector, int component) {
-  return std::size_t{3} * kDerivativeKinds + static_cast<std::size_t>(projector) * 2 +
-         static_cast<std::size_t>(component);
-}
+// separate()'s rows: a ring of horizontally filtered rows (int32; 5 rows × 3 channels × 3
+// filters) and the current row's derivatives, unit vectors and tile data (int16).
+inline constexpr std::size_t kFilterRows = 45;
+inline constexpr std::size_t kWorkRows = 39;
 
 // The signed difference a − b of two BinAngle raw values, wrapped into [−2^15, 2^15).
 [[nodiscard]] inline std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
@@ -143,14 +125,16 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
                            std::span<const DirectionPlane> out);
 
-// Stages 3–4 for one projector: separated, colour-normalised derivative per channel (Q4.11) and
-// the derivative order per pixel (1 or 2; 0 on the border).
-void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
+// Stages 3–4 for every projector in one sweep: per projector, the separated, colour-normalised
+// derivative per channel (Q4.11) and the derivative order per pixel (1 or 2; 0 on the border).
+// Output row y is written after row y + 2 of smoothed is read, and no row of smoothed is read
+// twice, so one projector's separated planes may take smoothed's memory.
+void separate(const Planes3& smoothed, const DemuxLayout& layout,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const RowBlock& filtered, const RowBlock& derivs,
-              std::span<const DirectionPlane> directions, const Planes3& separated,
-              ImageView<std::uint8_t> order);
+              const UnitTable& units, const RowBlock<std::int32_t>& filtered,
+              const RowBlock<std::int16_t>& work, std::span<const DirectionPlane> directions,
+              std::span<const Planes3> separated, std::span<const ImageView<std::uint8_t>> order);
 
 // detectBoundaries()'s minStrength: the parameter's per mille of the local colour in Q4.11.
 [[nodiscard]] constexpr int minStrengthQ11(const DemuxParams& params) {

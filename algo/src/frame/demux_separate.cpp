@@ -1,20 +1,22 @@
 // Stages 3–4: pattern separation by steered derivatives (paper eqs 6–10) and division by the
-// locally averaged colour (§4.3).
+// locally averaged colour (§4.3), every projector in one sweep over the rows.
 //   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
 //   to the pixel; unit vectors Q1.14 from the table. Presence: the nearest tile's.
 //   Derivatives of S by matched 5-tap separable filters (below), row-streamed: the horizontal
-//   filters of rows y − 2 … y + 2 are kept in a ring (int32), the vertical ones applied per pixel
-//   in int64. D values are 2 × the derivative of S (32 × grey/px for the first order).
+//   filters of rows y − 2 … y + 2 are kept in a ring (int32), the vertical ones applied per row.
+//   They are the same for every projector, so each row's are formed once and every projector is
+//   steered from them. D values are 2 × the derivative of S (32 × grey/px for the first order).
 //   First order  D_c = v · (gx, gy)_c; v = the projector's own axis (no other pattern present)
 //                or the normal of the other pattern's axis, signed towards this projector's
 //                axis (so the surviving term keeps its sign).
 //   Second order D_c = vᵀ H_c w; v, w the normals of the two other patterns' axes, signed
 //                likewise.
-//   Products of Q1.14 coefficients in int32 (they fit), one shift each. Normalised value
-//   N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour, saturated to
-//   int16 (D_c clamped first to where it saturates anyway, so the product fits in int32).
-//   The steering runs per run of pixels sharing the nearest tile, in branch-free loops that GCC
-//   vectorises; the derivative rows and unit vectors it reads are formed once per row.
+//   Normalised value N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour,
+//   saturated to int16.
+//   Since 0 <= S <= 16 × 255, every derivative (|·| <= 16 575 after the 2^-13 below), unit
+//   vector, steering coefficient and D (|D| < 2^14) fits int16: the steering multiplies int16 by
+//   int16 into int32, which the vector units do natively. The steering runs per span of pixels
+//   whose nearest tiles hold the same other patterns, in branch-free loops that GCC vectorises.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -26,57 +28,130 @@ namespace smx::algo::demux {
 
 namespace {
 
+// The ring: rows y − 2 … y + 2 in slots (row + 5) % 5, per channel the prefilter, first and
+// second derivative.
+constexpr int kFilterSlots = 5;
+static_assert(kFilterRows == std::size_t{kFilterSlots} * 3 * 3);
+constexpr std::size_t filterRowIndex(int slot, int channel, int filter) {
+  return (static_cast<std::size_t>(slot) * 3 + static_cast<std::size_t>(channel)) * 3 +
+         static_cast<std::size_t>(filter);
+}
+
+// The int16 working rows: the current row's derivatives per channel, every projector's unit
+// vectors along it, the tile colour per channel and pixel, and per tile row and projector which
+// other patterns each tile column holds; then the tile runs (first pixel and tile of each) and
+// which derivative orders each tile column needs; then one projector's steering results.
+enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
+constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
+  return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
+}
+constexpr std::size_t kUnitRows = std::size_t{3} * kDerivativeKinds;
+constexpr std::size_t unitRowIndex(int projector, int component) {
+  return kUnitRows + static_cast<std::size_t>(projector) * 2 + static_cast<std::size_t>(component);
+}
+constexpr std::size_t kColourRows = kUnitRows + std::size_t{2} * kMaxProjectors;
+constexpr std::size_t colourRowIndex(std::size_t channel, int part) {
+  return kColourRows + channel * 2 + static_cast<std::size_t>(part);
+}
+constexpr std::size_t kOthersRows = kColourRows + 6;
+constexpr std::size_t othersRowIndex(int projector) {
+  return kOthersRows + static_cast<std::size_t>(projector);
+}
+constexpr std::size_t kRunStartRow = kOthersRows + kMaxProjectors;
+constexpr std::size_t kRunTileRow = kRunStartRow + 1;
+constexpr std::size_t kNeedsRow = kRunTileRow + 1;
+constexpr std::size_t kSteerRows = kNeedsRow + 1;  // D per channel, then cxx, cxy, cyy
+static_assert(kWorkRows == kSteerRows + 6);
+
 // The horizontal prefilter and first derivative of one row of one channel, for x in [2, w − 3].
-void filterRow(const std::int16_t* s, int w, std::int32_t* pre, std::int32_t* d1) {
+// Sums and differences of two S values fit int16 (0 <= S <= 16 × 255), and GCC multiplies int16
+// by a constant into int32 in int16 lanes.
+void filterRow(const std::int16_t* s, int w, std::int32_t* __restrict pre,
+               std::int32_t* __restrict d1) {
   for (int x = 2; x + 2 < w; ++x) {
-    const std::int32_t m2 = s[x - 2];
-    const std::int32_t m1 = s[x - 1];
-    const std::int32_t c0 = s[x];
-    const std::int32_t p1 = s[x + 1];
-    const std::int32_t p2 = s[x + 2];
-    pre[x] = kPre[0] * (m2 + p2) + kPre[1] * (m1 + p1) + kPre[2] * c0;
-    d1[x] = kD1[3] * (p1 - m1) + kD1[4] * (p2 - m2);
+    const auto outer = static_cast<std::int16_t>(s[x - 2] + s[x + 2]);
+    const auto inner = static_cast<std::int16_t>(s[x - 1] + s[x + 1]);
+    const auto near = static_cast<std::int16_t>(s[x + 1] - s[x - 1]);
+    const auto far = static_cast<std::int16_t>(s[x + 2] - s[x - 2]);
+    pre[x] = kPre[0] * outer + kPre[1] * inner + kPre[2] * s[x];
+    d1[x] = kD1[3] * near + kD1[4] * far;
   }
 }
 
 // The horizontal second derivative (needed with three projectors only).
-void filterRowSecond(const std::int16_t* s, int w, std::int32_t* d2) {
+void filterRowSecond(const std::int16_t* s, int w, std::int32_t* __restrict d2) {
   for (int x = 2; x + 2 < w; ++x) {
-    d2[x] = kD2[0] * (s[x - 2] + s[x + 2]) + kD2[2] * s[x];
+    const auto outer = static_cast<std::int16_t>(s[x - 2] + s[x + 2]);
+    d2[x] = kD2[0] * outer + kD2[2] * s[x];
   }
 }
 
-// The vertical halves over rows y − 2 … y + 2 for a whole row, scaled by 2^-kRowShift (the rows
-// and the output never overlap: restrict lets the loops vectorise).
+// The vertical halves over rows y − 2 … y + 2 for x in [x0, x1), scaled by 2^-kRowShift into
+// int16 (the rows and the output never overlap: restrict lets the loops vectorise).
 constexpr int kRowShift = 13;
 
-void verticalSmoothed(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+void verticalSmoothed(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                      int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r1 = rows[1];
   const std::int32_t* __restrict r2 = rows[2];
   const std::int32_t* __restrict r3 = rows[3];
   const std::int32_t* __restrict r4 = rows[4];
-  for (int x = 2; x + 2 < w; ++x) {
-    out[x] = (kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x]) >> kRowShift;
+  for (int x = x0; x < x1; ++x) {
+    out[x] = static_cast<std::int16_t>(
+        (kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x]) >> kRowShift);
   }
 }
 
-void verticalDerivative(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+void verticalDerivative(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                        int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r1 = rows[1];
   const std::int32_t* __restrict r3 = rows[3];
   const std::int32_t* __restrict r4 = rows[4];
-  for (int x = 2; x + 2 < w; ++x) {
-    out[x] = (kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x])) >> kRowShift;
+  for (int x = x0; x < x1; ++x) {
+    out[x] = static_cast<std::int16_t>((kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x])) >>
+                                       kRowShift);
   }
 }
 
-void verticalSecond(const std::int32_t* const (&rows)[5], std::int32_t* __restrict out, int w) {
+void verticalSecond(const std::int32_t* const (&rows)[5], std::int16_t* __restrict out, int x0,
+                    int x1) {
   const std::int32_t* __restrict r0 = rows[0];
   const std::int32_t* __restrict r2 = rows[2];
   const std::int32_t* __restrict r4 = rows[4];
+  for (int x = x0; x < x1; ++x) {
+    out[x] = static_cast<std::int16_t>((kD2[0] * (r0[x] + r4[x]) + kD2[2] * r2[x]) >> kRowShift);
+  }
+}
+
+// The unit table's cos and sin of each entry in one word (cos low, sin high), so that a pixel's
+// unit vector takes one scalar load (lookups do not vectorise).
+constexpr std::uint32_t kUnitStep = 65536 / UnitTable::kEntries;
+
+struct PackedUnits {
+  std::array<std::uint32_t, UnitTable::kEntries> entries{};
+
+  explicit PackedUnits(const UnitTable& units) {
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const auto angle = static_cast<std::uint16_t>(i * kUnitStep);
+      entries[i] = static_cast<std::uint16_t>(units.cosOf(angle)) |
+                   static_cast<std::uint32_t>(static_cast<std::uint16_t>(units.sinOf(angle)))
+                       << 16U;
+    }
+  }
+  // The nearest entry, as UnitTable takes it.
+  [[nodiscard]] std::uint32_t of(std::uint16_t angle) const {
+    return entries[((angle + kUnitStep / 2) / kUnitStep) % UnitTable::kEntries];
+  }
+};
+
+void lookUpUnits(const std::uint16_t* angles, const PackedUnits& units, int w, std::int16_t* cosRow,
+                 std::int16_t* sinRow) {
   for (int x = 2; x + 2 < w; ++x) {
-    out[x] = (kD2[0] * (r0[x] + r4[x]) + kD2[2] * r2[x]) >> kRowShift;
+    const std::uint32_t both = units.of(angles[x]);
+    cosRow[x] = static_cast<std::int16_t>(both & 0xffffU);
+    sinRow[x] = static_cast<std::int16_t>(both >> 16U);
   }
 }
 
@@ -85,166 +160,161 @@ void verticalSecond(const std::int32_t* const (&rows)[5], std::int32_t* __restri
 namespace {
 
 // One row's steering inputs and outputs, x in [2, w − 3]. The per-pixel loops below are written
-// for GCC's vectoriser: straight-line int32 arithmetic with selects instead of branches, no
-// table lookups (the unit vectors are looked up beforehand into rows of their own), and the
-// int16 outputs cannot alias the int32 inputs.
+// for GCC's vectoriser: straight-line int16/int32 arithmetic with selects instead of branches, no
+// table lookups (the unit vectors and the tile colour are spread into rows of their own
+// beforehand), and rows that never overlap (ivdep). GCC multiplies int16 by int16 into int32 in
+// int16 lanes only when both factors are loaded as int16, so the steering coefficients of the
+// second order and D go through rows of their own.
 struct SteerRow {
-  const std::int32_t* gx[3];
-  const std::int32_t* gy[3];
-  const std::int32_t* hxx[3];
-  const std::int32_t* hyy[3];
-  const std::int32_t* hxy[3];
-  std::int16_t* out[3];
+  const std::int16_t* gx[3];
+  const std::int16_t* gy[3];
+  const std::int16_t* hxx[3];
+  const std::int16_t* hyy[3];
+  const std::int16_t* hxy[3];
+  std::int16_t* cxx;  // the second order's steering coefficients
+  std::int16_t* cxy;
+  std::int16_t* cyy;
+  std::int16_t* d[3];  // D per channel
 };
 
-// The unit vector rows (Q1.14) of one direction row, looked up once per row.
+// The unit vector rows (Q1.14) of one direction row.
 struct UnitRows {
-  const std::int32_t* cos;
-  const std::int32_t* sin;
+  const std::int16_t* cos;
+  const std::int16_t* sin;
 };
 
-void lookUpUnits(const std::uint16_t* angles, const UnitTable& units, int w, std::int32_t* cosRow,
-                 std::int32_t* sinRow) {
-  for (int x = 2; x + 2 < w; ++x) {
-    cosRow[x] = units.cosOf(angles[x]);
-    sinRow[x] = units.sinOf(angles[x]);
-  }
-}
-
-// Row derivatives keep 2^-13 of the filter output (|value| < 2^16); steering by Q1.14
-// coefficients then shifts by 14 + 2 to reach D = 2·∂S (the filters' unit is 2^15 · 2·∂S).
+// Row derivatives keep 2^-13 of the filter output; steering by Q1.14 coefficients then shifts by
+// 14 + 2 to reach D = 2·∂S (the filters' unit is 2^15 · 2·∂S).
 constexpr int kSteerShift = kUnitShift + kDerivShift - kRowShift;
 
-// Division by the tile's average colour: N = D · inverse >> kNormShift saturated to int16, where
-// the product is taken in int64. D is first clamped to ±limit, the smallest magnitude that
-// saturates anyway (limit · inverse ≥ 2^28), so that the product fits in int32 (inverse <= 2^24
-// / kColourFloor = 2^17, hence limit · inverse < 2^28 + 2^17) and the result is the same.
-constexpr int kNormShift = kInverseShift - kRelativeShift;
-
-struct TileColour {
-  std::int32_t inverse[3];
-  std::int32_t limit[3];
-};
-
-TileColour tileColour(const std::uint32_t* inverse) {
-  constexpr std::int64_t kSaturating = std::int64_t{1} << (15 + kNormShift);
-  TileColour t{};
-  for (std::size_t c = 0; c < 3; ++c) {
-    const std::int64_t inv = inverse[c];
-    t.inverse[c] = static_cast<std::int32_t>(inv);
-    t.limit[c] =
-        inv == 0 ? std::int32_t{1} << 30 : static_cast<std::int32_t>((kSaturating + inv - 1) / inv);
-  }
-  return t;
-}
-
-// Values, not references (std::clamp's), so that GCC if-converts the selects.
-[[gnu::always_inline]] inline std::int32_t clampTo(std::int32_t v, std::int32_t lo,
-                                                   std::int32_t hi) {
-  const std::int32_t upper = v > hi ? hi : v;
-  return upper < lo ? lo : upper;
-}
-
-// Below the contrast floor (noise in shadows and on black) nothing is separated: the division
-// by a dark average would lift it over the relative threshold.
-[[gnu::always_inline]] inline void store(std::int16_t* __restrict const (&out)[3], int x,
-                                         std::int32_t r0, std::int32_t r1, std::int32_t r2,
-                                         const TileColour& colour, std::int32_t minContrast) {
-  const std::int32_t hi01 = r0 > r1 ? r0 : r1;
-  const std::int32_t lo01 = r0 < r1 ? r0 : r1;
-  const std::int32_t hi = hi01 > r2 ? hi01 : r2;
-  const std::int32_t lo = lo01 < r2 ? lo01 : r2;
-  const std::int32_t keep = hi - lo < minContrast ? 0 : 1;
-  const std::int32_t raw[3] = {r0, r1, r2};
-  for (std::size_t c = 0; c < 3; ++c) {
-    const std::int32_t product =
-        clampTo(raw[c], -colour.limit[c], colour.limit[c]) * colour.inverse[c];
-    out[c][x] = static_cast<std::int16_t>(clampTo(product >> kNormShift, -32768, 32767) * keep);
-  }
-}
-
-// The normal (−sin, cos) of a unit vector, turned if its dot product with the own axis is
-// negative (|dot| <= 2^29: exact in int32), so that the surviving term keeps its sign.
-struct Normal {
-  std::int32_t x;
-  std::int32_t y;
-};
-[[gnu::always_inline]] inline Normal normalTowards(std::int32_t cos, std::int32_t sin,
-                                                   std::int32_t ownCos, std::int32_t ownSin) {
-  const std::int32_t dot = -sin * ownCos + cos * ownSin;
-  return dot < 0 ? Normal{sin, -cos} : Normal{-sin, cos};
+// The normal of another pattern's axis (cos, sin) steered along: (−sin, cos), turned if its dot
+// product with the own axis is negative (|dot| <= 2^29: exact in int32), so that the surviving
+// term keeps its sign. The loops below apply the turn as a sign of their products, whose
+// factors then are all loaded int16 values.
+[[gnu::always_inline]] inline bool turned(std::int16_t cos, std::int16_t sin, std::int16_t ownCos,
+                                          std::int16_t ownSin) {
+  return cos * ownSin - sin * ownCos < 0;
 }
 
 // First order along the own axis (no other pattern present) for x in [x0, x1).
-void steerAlong(const SteerRow& r, UnitRows own, int x0, int x1, const TileColour& colour,
-                std::int32_t minContrast) {
-  const std::int32_t* __restrict vx = own.cos;
-  const std::int32_t* __restrict vy = own.sin;
-  const std::int32_t* __restrict gx0 = r.gx[0];
-  const std::int32_t* __restrict gx1 = r.gx[1];
-  const std::int32_t* __restrict gx2 = r.gx[2];
-  const std::int32_t* __restrict gy0 = r.gy[0];
-  const std::int32_t* __restrict gy1 = r.gy[1];
-  const std::int32_t* __restrict gy2 = r.gy[2];
-  std::int16_t* __restrict const out[3] = {r.out[0], r.out[1], r.out[2]};
-  for (int x = x0; x < x1; ++x) {
-    store(out, x, (vx[x] * gx0[x] + vy[x] * gy0[x]) >> kSteerShift,
-          (vx[x] * gx1[x] + vy[x] * gy1[x]) >> kSteerShift,
-          (vx[x] * gx2[x] + vy[x] * gy2[x]) >> kSteerShift, colour, minContrast);
+void steerAlong(const SteerRow& r, UnitRows own, int x0, int x1) {
+  const std::int16_t* vx = own.cos;
+  const std::int16_t* vy = own.sin;
+  for (std::size_t c = 0; c < 3; ++c) {
+    const std::int16_t* gx = r.gx[c];
+    const std::int16_t* gy = r.gy[c];
+    std::int16_t* d = r.d[c];
+#pragma GCC ivdep
+    for (int x = x0; x < x1; ++x) {
+      d[x] = static_cast<std::int16_t>((vx[x] * gx[x] + vy[x] * gy[x]) >> kSteerShift);
+    }
   }
 }
 
 // First order along the normal of the other pattern's axis.
-void steerAcross(const SteerRow& r, UnitRows own, UnitRows other, int x0, int x1,
-                 const TileColour& colour, std::int32_t minContrast) {
-  const std::int32_t* __restrict ownCos = own.cos;
-  const std::int32_t* __restrict ownSin = own.sin;
-  const std::int32_t* __restrict cos = other.cos;
-  const std::int32_t* __restrict sin = other.sin;
-  const std::int32_t* __restrict gx0 = r.gx[0];
-  const std::int32_t* __restrict gx1 = r.gx[1];
-  const std::int32_t* __restrict gx2 = r.gx[2];
-  const std::int32_t* __restrict gy0 = r.gy[0];
-  const std::int32_t* __restrict gy1 = r.gy[1];
-  const std::int32_t* __restrict gy2 = r.gy[2];
-  std::int16_t* __restrict const out[3] = {r.out[0], r.out[1], r.out[2]};
+void steerAcross(const SteerRow& r, UnitRows own, UnitRows other, int x0, int x1) {
+  const std::int16_t* ownCos = own.cos;
+  const std::int16_t* ownSin = own.sin;
+  const std::int16_t* cos = other.cos;
+  const std::int16_t* sin = other.sin;
+  const std::int16_t* gx0 = r.gx[0];
+  const std::int16_t* gx1 = r.gx[1];
+  const std::int16_t* gx2 = r.gx[2];
+  const std::int16_t* gy0 = r.gy[0];
+  const std::int16_t* gy1 = r.gy[1];
+  const std::int16_t* gy2 = r.gy[2];
+  std::int16_t* d0 = r.d[0];
+  std::int16_t* d1 = r.d[1];
+  std::int16_t* d2 = r.d[2];
+#pragma GCC ivdep
   for (int x = x0; x < x1; ++x) {
-    const Normal v = normalTowards(cos[x], sin[x], ownCos[x], ownSin[x]);
-    store(out, x, (v.x * gx0[x] + v.y * gy0[x]) >> kSteerShift,
-          (v.x * gx1[x] + v.y * gy1[x]) >> kSteerShift,
-          (v.x * gx2[x] + v.y * gy2[x]) >> kSteerShift, colour, minContrast);
+    // v · g = ±(cos·gy − sin·gx)
+    const bool turn = turned(cos[x], sin[x], ownCos[x], ownSin[x]);
+    const std::int32_t e0 = cos[x] * gy0[x] - sin[x] * gx0[x];
+    const std::int32_t e1 = cos[x] * gy1[x] - sin[x] * gx1[x];
+    const std::int32_t e2 = cos[x] * gy2[x] - sin[x] * gx2[x];
+    d0[x] = static_cast<std::int16_t>((turn ? -e0 : e0) >> kSteerShift);
+    d1[x] = static_cast<std::int16_t>((turn ? -e1 : e1) >> kSteerShift);
+    d2[x] = static_cast<std::int16_t>((turn ? -e2 : e2) >> kSteerShift);
   }
 }
 
 // Second order: the mixed derivative along the normals of both other patterns' axes.
-void steerMixed(const SteerRow& r, UnitRows own, UnitRows first, UnitRows second, int x0, int x1,
-                const TileColour& colour, std::int32_t minContrast) {
-  const std::int32_t* __restrict ownCos = own.cos;
-  const std::int32_t* __restrict ownSin = own.sin;
-  const std::int32_t* __restrict cosV = first.cos;
-  const std::int32_t* __restrict sinV = first.sin;
-  const std::int32_t* __restrict cosU = second.cos;
-  const std::int32_t* __restrict sinU = second.sin;
-  const std::int32_t* __restrict hxx0 = r.hxx[0];
-  const std::int32_t* __restrict hxx1 = r.hxx[1];
-  const std::int32_t* __restrict hxx2 = r.hxx[2];
-  const std::int32_t* __restrict hyy0 = r.hyy[0];
-  const std::int32_t* __restrict hyy1 = r.hyy[1];
-  const std::int32_t* __restrict hyy2 = r.hyy[2];
-  const std::int32_t* __restrict hxy0 = r.hxy[0];
-  const std::int32_t* __restrict hxy1 = r.hxy[1];
-  const std::int32_t* __restrict hxy2 = r.hxy[2];
-  std::int16_t* __restrict const out[3] = {r.out[0], r.out[1], r.out[2]};
+void steerMixed(const SteerRow& r, UnitRows own, UnitRows first, UnitRows second, int x0, int x1) {
+  const std::int16_t* ownCos = own.cos;
+  const std::int16_t* ownSin = own.sin;
+  const std::int16_t* cosV = first.cos;
+  const std::int16_t* sinV = first.sin;
+  const std::int16_t* cosU = second.cos;
+  const std::int16_t* sinU = second.sin;
+  std::int16_t* cxx = r.cxx;
+  std::int16_t* cxy = r.cxy;
+  std::int16_t* cyy = r.cyy;
+#pragma GCC ivdep
   for (int x = x0; x < x1; ++x) {
-    const Normal v = normalTowards(cosV[x], sinV[x], ownCos[x], ownSin[x]);
-    const Normal u = normalTowards(cosU[x], sinU[x], ownCos[x], ownSin[x]);
-    // Q1.14 coefficients of the mixed derivative; |cxx| + |cxy| + |cyy| <= 2^15.
-    const std::int32_t cxx = (v.x * u.x) >> kUnitShift;
-    const std::int32_t cyy = (v.y * u.y) >> kUnitShift;
-    const std::int32_t cxy = (v.x * u.y + v.y * u.x) >> kUnitShift;
-    store(out, x, (cxx * hxx0[x] + cxy * hxy0[x] + cyy * hyy0[x]) >> kSteerShift,
-          (cxx * hxx1[x] + cxy * hxy1[x] + cyy * hyy1[x]) >> kSteerShift,
-          (cxx * hxx2[x] + cxy * hxy2[x] + cyy * hyy2[x]) >> kSteerShift, colour, minContrast);
+    // Q1.14 coefficients of the mixed derivative vᵀ H u, each <= |v|·|u| <= 2^14 (+ table
+    // rounding): with v = ±(−sinV, cosV) and u = ±(−sinU, cosU), cxx = ±sinV·sinU,
+    // cyy = ±cosV·cosU, cxy = ∓(sinV·cosU + cosV·sinU).
+    const bool flip = turned(cosV[x], sinV[x], ownCos[x], ownSin[x]) !=
+                      turned(cosU[x], sinU[x], ownCos[x], ownSin[x]);
+    const std::int32_t xx = sinV[x] * sinU[x];
+    const std::int32_t yy = cosV[x] * cosU[x];
+    const std::int32_t xy = sinV[x] * cosU[x] + cosV[x] * sinU[x];
+    cxx[x] = static_cast<std::int16_t>((flip ? -xx : xx) >> kUnitShift);
+    cyy[x] = static_cast<std::int16_t>((flip ? -yy : yy) >> kUnitShift);
+    cxy[x] = static_cast<std::int16_t>((flip ? xy : -xy) >> kUnitShift);
+  }
+  const auto mixed = [](std::int16_t xx, std::int16_t xy, std::int16_t yy, std::int16_t hxx,
+                        std::int16_t hxy, std::int16_t hyy) {
+    return static_cast<std::int16_t>((xx * hxx + xy * hxy + yy * hyy) >> kSteerShift);
+  };
+  std::int16_t* d0 = r.d[0];
+  std::int16_t* d1 = r.d[1];
+  std::int16_t* d2 = r.d[2];
+#pragma GCC ivdep
+  for (int x = x0; x < x1; ++x) {
+    d0[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[0][x], r.hxy[0][x], r.hyy[0][x]);
+    d1[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[1][x], r.hxy[1][x], r.hyy[1][x]);
+    d2[x] = mixed(cxx[x], cxy[x], cyy[x], r.hxx[2][x], r.hxy[2][x], r.hyy[2][x]);
+  }
+}
+
+// The tile's inverse colour 2^24 / average (<= 2^24 / kColourFloor = 2^17) per pixel as high
+// (>> 4) and low (& 15) parts, both int16.
+struct ColourRows {
+  const std::int16_t* high[3];
+  const std::int16_t* low[3];
+};
+
+// D · inverse >> kNormShift saturated to int16, as the exact product would give: with inverse =
+// 16·high + low, D · inverse >> 13 = (D · high + (D · low >> 4)) >> 9 (floor division nests), and
+// D · high < 2^14 · 2^13 fits int32.
+constexpr int kNormShift = kInverseShift - kRelativeShift;
+constexpr int kInverseSplit = 4;
+
+// Below the contrast floor (noise in shadows and on black) nothing is separated: the division
+// by a dark average would lift it over the relative threshold.
+void normaliseRow(const SteerRow& r, const ColourRows& colour, std::int32_t minContrast, int w,
+                  std::int16_t* const (&out)[3]) {
+  const std::int16_t* d0 = r.d[0];
+  const std::int16_t* d1 = r.d[1];
+  const std::int16_t* d2 = r.d[2];
+  const auto scale = [](std::int16_t d, std::int16_t high, std::int16_t low) {
+    const std::int32_t scaled =
+        (d * high + ((d * low) >> kInverseSplit)) >> (kNormShift - kInverseSplit);
+    const std::int32_t upper = scaled > 32767 ? 32767 : scaled;
+    return static_cast<std::int16_t>(upper < -32768 ? -32768 : upper);
+  };
+#pragma GCC ivdep
+  for (int x = 2; x + 2 < w; ++x) {
+    const std::int16_t hi01 = d0[x] > d1[x] ? d0[x] : d1[x];
+    const std::int16_t lo01 = d0[x] < d1[x] ? d0[x] : d1[x];
+    const std::int16_t hi = hi01 > d2[x] ? hi01 : d2[x];
+    const std::int16_t lo = lo01 < d2[x] ? lo01 : d2[x];
+    const std::int16_t keep = hi - lo >= minContrast ? std::int16_t{-1} : std::int16_t{0};
+    out[0][x] = static_cast<std::int16_t>(scale(d0[x], colour.high[0][x], colour.low[0][x]) & keep);
+    out[1][x] = static_cast<std::int16_t>(scale(d1[x], colour.high[1][x], colour.low[1][x]) & keep);
+    out[2][x] = static_cast<std::int16_t>(scale(d2[x], colour.high[2][x], colour.low[2][x]) & keep);
   }
 }
 
@@ -252,90 +322,151 @@ void steerMixed(const SteerRow& r, UnitRows own, UnitRows first, UnitRows second
 
 namespace {
 
-// Which other projectors the nearest tile found, per tile column of one tile row, and what the
-// row therefore needs.
-struct RowCases {
-  std::uint8_t others[2048] = {};  // bit q: projector q is present (tile columns <= 8192 / 4)
-  unsigned anyOthers = 0;          // the union of the bits
-  bool needFirst = false;          // some tile column has at most one other pattern
-  bool needSecond = false;         // some tile column has two
+// The runs of pixels in [2, w − 3] sharing the nearest tile column: run k starts at pixel
+// starts[k] (starts[runs] = w − 2) and has tile column tiles[k].
+struct TileRuns {
+  const std::int16_t* starts;
+  const std::int16_t* tiles;
+  int runs;
 };
 
-void classifyRow(std::span<const TileDirection> tiles, const DemuxLayout& layout, int projector,
-                 int tileRow, RowCases& cases) {
+TileRuns findRuns(std::span<const TileInterp> columns, int w, std::int16_t* starts,
+                  std::int16_t* tiles) {
+  int runs = 0;
+  for (int x = 2; x + 2 < w; ++x) {
+    const std::int16_t tx = columns[static_cast<std::size_t>(x)].nearest;
+    if (runs == 0 || tiles[runs - 1] != tx) {
+      starts[runs] = static_cast<std::int16_t>(x);
+      tiles[runs++] = tx;
+    }
+  }
+  starts[runs] = static_cast<std::int16_t>(w - 2);
+  return {starts, tiles, runs};
+}
+
+// Per tile row: which other projectors each projector's nearest tile holds (bit q: projector q's
+// pattern is present), and which derivative orders each tile column needs over all projectors.
+constexpr int kNeedFirst = 1;
+constexpr int kNeedSecond = 2;
+
+void classifyTileRow(std::span<const TileDirection> tiles, const DemuxLayout& layout, int tileRow,
+                     const RowBlock<std::int16_t>& work) {
   const int tilesX = layout.tilesX();
   const std::size_t tileCount = layout.tileCount();
-  cases.anyOthers = 0;
-  cases.needFirst = cases.needSecond = false;
-  for (int tx = 0; tx < tilesX; ++tx) {
-    unsigned bits = 0;
-    int count = 0;
-    for (int q = 0; q < layout.projectors; ++q) {
-      const std::size_t t = static_cast<std::size_t>(q) * tileCount +
-                            static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(tilesX) +
-                            static_cast<std::size_t>(tx);
-      if (q != projector && tiles[t].present != 0) {
-        bits |= 1U << q;
-        ++count;
+  const std::size_t rowStart = static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(tilesX);
+  std::int16_t* needs = work.row(kNeedsRow);
+  std::fill(needs, needs + tilesX, std::int16_t{0});
+  for (int p = 0; p < layout.projectors; ++p) {
+    std::int16_t* others = work.row(othersRowIndex(p));
+    for (int tx = 0; tx < tilesX; ++tx) {
+      unsigned bits = 0;
+      int count = 0;
+      for (int q = 0; q < layout.projectors; ++q) {
+        const std::size_t t =
+            static_cast<std::size_t>(q) * tileCount + rowStart + static_cast<std::size_t>(tx);
+        if (q != p && tiles[t].present != 0) {
+          bits |= 1U << q;
+          ++count;
+        }
       }
+      others[tx] = static_cast<std::int16_t>(bits);
+      needs[tx] = static_cast<std::int16_t>(needs[tx] | (count < 2 ? kNeedFirst : kNeedSecond));
     }
-    cases.others[tx] = static_cast<std::uint8_t>(bits);
-    cases.anyOthers |= bits;
-    (count < 2 ? cases.needFirst : cases.needSecond) = true;
   }
 }
 
-// One interior row, per run of pixels sharing the nearest tile: there the patterns present
-// (hence the derivative) and the colour are fixed, so each run is one branch-free loop.
-void steerRow(const SteerRow& steer, const RowCases& cases, const UnitRows (&unitRows)[3],
-              int projector, std::span<const TileInterp> columns,
-              const std::uint32_t* tileRowInverse, int w, std::int32_t minContrast,
-              std::uint8_t* orderRow) {
-  int x0 = 2;
-  while (x0 + 2 < w) {
-    const int tx = columns[static_cast<std::size_t>(x0)].nearest;
-    int x1 = x0 + 1;
-    while (x1 + 2 < w && columns[static_cast<std::size_t>(x1)].nearest == tx) {
-      ++x1;
+// Calls f(x0, x1) for each longest span of runs whose tile columns need the order.
+template <class F>
+void forSpansNeeding(const TileRuns& runs, const std::int16_t* needs, int order, F&& f) {
+  int k = 0;
+  while (k < runs.runs) {
+    if ((needs[runs.tiles[k]] & order) == 0) {
+      ++k;
+      continue;
     }
-    int others[2] = {0, 0};
+    int end = k + 1;
+    while (end < runs.runs && (needs[runs.tiles[end]] & order) != 0) {
+      ++end;
+    }
+    f(runs.starts[k], runs.starts[end]);
+    k = end;
+  }
+}
+
+void spreadTileColour(std::span<const std::uint32_t> inverseColour, const DemuxLayout& layout,
+                      int tileRow, const TileRuns& runs, const RowBlock<std::int16_t>& work) {
+  const std::uint32_t* inverse =
+      inverseColour.data() +
+      static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(layout.tilesX()) * 3;
+  for (std::size_t c = 0; c < 3; ++c) {
+    std::int16_t* high = work.row(colourRowIndex(c, 0));
+    std::int16_t* low = work.row(colourRowIndex(c, 1));
+    for (int k = 0; k < runs.runs; ++k) {
+      const std::uint32_t inv = inverse[static_cast<std::size_t>(runs.tiles[k]) * 3 + c];
+      std::fill(high + runs.starts[k], high + runs.starts[k + 1],
+                static_cast<std::int16_t>(inv >> kInverseSplit));
+      std::fill(low + runs.starts[k], low + runs.starts[k + 1],
+                static_cast<std::int16_t>(inv & ((1U << kInverseSplit) - 1)));
+    }
+  }
+}
+
+// One projector's interior row, per span of runs whose tiles hold the same other patterns:
+// there the derivative is fixed, so each span is one branch-free loop.
+void steerRow(const SteerRow& steer, const std::int16_t* others, const UnitRows (&unitRows)[3],
+              int projector, const TileRuns& runs, std::uint8_t* orderRow) {
+  int k = 0;
+  while (k < runs.runs) {
+    const std::int16_t bits = others[runs.tiles[k]];
+    int end = k + 1;
+    while (end < runs.runs && others[runs.tiles[end]] == bits) {
+      ++end;
+    }
+    const int x0 = runs.starts[k];
+    const int x1 = runs.starts[end];
+    int otherOf[2] = {0, 0};
     int otherCount = 0;
     for (int q = 0; q < kMaxProjectors; ++q) {
-      if ((cases.others[tx] & (1U << q)) != 0) {
-        others[otherCount++] = q;
+      if ((bits & (1 << q)) != 0) {
+        otherOf[otherCount++] = q;
       }
     }
-    const TileColour colour = tileColour(tileRowInverse + static_cast<std::size_t>(tx) * 3);
     const UnitRows own = unitRows[projector];
     if (otherCount == 0) {
-      steerAlong(steer, own, x0, x1, colour, minContrast);
+      steerAlong(steer, own, x0, x1);
     } else if (otherCount == 1) {
-      steerAcross(steer, own, unitRows[others[0]], x0, x1, colour, minContrast);
+      steerAcross(steer, own, unitRows[otherOf[0]], x0, x1);
     } else {
-      steerMixed(steer, own, unitRows[others[0]], unitRows[others[1]], x0, x1, colour, minContrast);
+      steerMixed(steer, own, unitRows[otherOf[0]], unitRows[otherOf[1]], x0, x1);
     }
     std::fill(orderRow + x0, orderRow + x1, otherCount < 2 ? 1 : 2);
-    x0 = x1;
+    k = end;
   }
+}
+
+void clearRow(const Planes3& separated, ImageView<std::uint8_t> order, int y, int x0, int x1) {
+  for (const ImageView<std::int16_t>& plane : separated) {
+    std::fill(plane.rowPtr(y) + x0, plane.rowPtr(y) + x1, std::int16_t{0});
+  }
+  std::fill(order.rowPtr(y) + x0, order.rowPtr(y) + x1, std::uint8_t{0});
 }
 
 }  // namespace
 
-void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
+void separate(const Planes3& smoothed, const DemuxLayout& layout,
               std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
               std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const RowBlock& filtered, const RowBlock& derivs,
-              std::span<const DirectionPlane> directions, const Planes3& separated,
-              ImageView<std::uint8_t> order) {
+              const UnitTable& units, const RowBlock<std::int32_t>& filtered,
+              const RowBlock<std::int16_t>& work, std::span<const DirectionPlane> directions,
+              std::span<const Planes3> separated, std::span<const ImageView<std::uint8_t>> order) {
   const int w = layout.width;
   const int h = layout.height;
   const int projectors = layout.projectors;
   // The second derivatives are only ever steered with three projectors.
   const bool second = projectors == kMaxProjectors;
-  // D is 2·∂S = 32 × grey level per pixel.
-  const std::int32_t minContrast = layout.params.minContrastGrey * 2 * kSmoothScale;
-  // Rows y − 2 … y + 2 live in slots (row + 5) % 5 of the ring; rows outside are never read.
   const auto slotOf = [](int row) { return (row + kFilterSlots) % kFilterSlots; };
+  // Row `row` of S is read here, before row `row` − 2 of any output is written: an output may
+  // take S's memory.
   const auto fill = [&](int row) {
     for (int c = 0; c < 3; ++c) {
       const int slot = slotOf(row);
@@ -351,47 +482,50 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
     fill(row);
   }
 
+  const TileRuns runs = findRuns(columns, w, work.row(kRunStartRow), work.row(kRunTileRow));
   SteerRow steer{};
+  ColourRows colour{};
   for (std::size_t c = 0; c < 3; ++c) {
-    steer.gx[c] = derivs.row(derivativeRowIndex(c, kGx));
-    steer.gy[c] = derivs.row(derivativeRowIndex(c, kGy));
-    steer.hxx[c] = derivs.row(derivativeRowIndex(c, kHxx));
-    steer.hyy[c] = derivs.row(derivativeRowIndex(c, kHyy));
-    steer.hxy[c] = derivs.row(derivativeRowIndex(c, kHxy));
+    steer.gx[c] = work.row(derivativeRowIndex(c, kGx));
+    steer.gy[c] = work.row(derivativeRowIndex(c, kGy));
+    steer.hxx[c] = work.row(derivativeRowIndex(c, kHxx));
+    steer.hyy[c] = work.row(derivativeRowIndex(c, kHyy));
+    steer.hxy[c] = work.row(derivativeRowIndex(c, kHxy));
+    steer.d[c] = work.row(kSteerRows + c);
+    colour.high[c] = work.row(colourRowIndex(c, 0));
+    colour.low[c] = work.row(colourRowIndex(c, 1));
   }
+  steer.cxx = work.row(kSteerRows + 3);
+  steer.cxy = work.row(kSteerRows + 4);
+  steer.cyy = work.row(kSteerRows + 5);
+  // D is 2·∂S = 32 × grey level per pixel.
+  const std::int32_t minContrast = layout.params.minContrastGrey * 2 * kSmoothScale;
   UnitRows unitRows[kMaxProjectors] = {};
   for (int q = 0; q < projectors; ++q) {
-    unitRows[q] = {derivs.row(unitRowIndex(q, 0)), derivs.row(unitRowIndex(q, 1))};
+    unitRows[q] = {work.row(unitRowIndex(q, 0)), work.row(unitRowIndex(q, 1))};
   }
-  RowCases cases;
+  const PackedUnits packedUnits(units);
   int casesRow = -1;
 
   for (int y = 0; y < h; ++y) {
     if (y + 2 < h && y >= 2) {
       fill(y + 2);
     }
-    std::int16_t* out[3] = {separated[0].rowPtr(y), separated[1].rowPtr(y), separated[2].rowPtr(y)};
-    std::uint8_t* orderRow = order.rowPtr(y);
     if (y < 2 || y + 2 >= h) {
-      for (std::int16_t* row : out) {
-        std::fill_n(row, w, std::int16_t{0});
+      for (int p = 0; p < projectors; ++p) {
+        clearRow(separated[static_cast<std::size_t>(p)], order[static_cast<std::size_t>(p)], y, 0,
+                 w);
       }
-      std::fill_n(orderRow, w, std::uint8_t{0});
       continue;
     }
-    for (std::size_t c = 0; c < 3; ++c) {
-      steer.out[c] = out[c];
-      out[c][0] = out[c][1] = out[c][w - 2] = out[c][w - 1] = 0;
-    }
-    orderRow[0] = orderRow[1] = orderRow[w - 2] = orderRow[w - 1] = 0;
     const int tileRow = rows[static_cast<std::size_t>(y)].nearest;
     if (tileRow != casesRow) {
-      classifyRow(tiles, layout, projector, tileRow, cases);
+      classifyTileRow(tiles, layout, tileRow, work);
+      spreadTileColour(inverseColour, layout, tileRow, runs, work);
       casesRow = tileRow;
     }
-    // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel, for the
-    // whole row (int32, vectorisable), scaled by 2^-13 into int32 range for the steering; only
-    // the derivatives some pixel of the row steers.
+    // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel; only the
+    // derivatives some pixel steers, where it does.
     for (std::size_t c = 0; c < 3; ++c) {
       const std::int32_t* pre[5] = {};
       const std::int32_t* d1[5] = {};
@@ -402,27 +536,30 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout, int projector,
         d1[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 1));
         d2[k] = filtered.row(filterRowIndex(slot, static_cast<int>(c), 2));
       }
-      if (cases.needFirst) {
-        verticalSmoothed(d1, derivs.row(derivativeRowIndex(c, kGx)), w);
-        verticalDerivative(pre, derivs.row(derivativeRowIndex(c, kGy)), w);
-      }
-      if (cases.needSecond) {
-        verticalSmoothed(d2, derivs.row(derivativeRowIndex(c, kHxx)), w);
-        verticalSecond(pre, derivs.row(derivativeRowIndex(c, kHyy)), w);
-        verticalDerivative(d1, derivs.row(derivativeRowIndex(c, kHxy)), w);
-      }
+      const std::int16_t* needs = work.row(kNeedsRow);
+      forSpansNeeding(runs, needs, kNeedFirst, [&](int x0, int x1) {
+        verticalSmoothed(d1, work.row(derivativeRowIndex(c, kGx)), x0, x1);
+        verticalDerivative(pre, work.row(derivativeRowIndex(c, kGy)), x0, x1);
+      });
+      forSpansNeeding(runs, needs, kNeedSecond, [&](int x0, int x1) {
+        verticalSmoothed(d2, work.row(derivativeRowIndex(c, kHxx)), x0, x1);
+        verticalSecond(pre, work.row(derivativeRowIndex(c, kHyy)), x0, x1);
+        verticalDerivative(d1, work.row(derivativeRowIndex(c, kHxy)), x0, x1);
+      });
     }
-    // The unit vectors of the own axis and of the others present somewhere along the row.
     for (int q = 0; q < projectors; ++q) {
-      if (q == projector || (cases.anyOthers & (1U << q)) != 0) {
-        lookUpUnits(directions[static_cast<std::size_t>(q)].rowPtr(y), units, w,
-                    derivs.row(unitRowIndex(q, 0)), derivs.row(unitRowIndex(q, 1)));
-      }
+      lookUpUnits(directions[static_cast<std::size_t>(q)].rowPtr(y), packedUnits, w,
+                  work.row(unitRowIndex(q, 0)), work.row(unitRowIndex(q, 1)));
     }
-    const std::uint32_t* tileRowInverse =
-        inverseColour.data() +
-        static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(layout.tilesX()) * 3;
-    steerRow(steer, cases, unitRows, projector, columns, tileRowInverse, w, minContrast, orderRow);
+    for (int p = 0; p < projectors; ++p) {
+      const Planes3& planes = separated[static_cast<std::size_t>(p)];
+      clearRow(planes, order[static_cast<std::size_t>(p)], y, 0, 2);
+      clearRow(planes, order[static_cast<std::size_t>(p)], y, w - 2, w);
+      steerRow(steer, work.row(othersRowIndex(p)), unitRows, p, runs,
+               order[static_cast<std::size_t>(p)].rowPtr(y));
+      std::int16_t* const out[3] = {planes[0].rowPtr(y), planes[1].rowPtr(y), planes[2].rowPtr(y)};
+      normaliseRow(steer, colour, minContrast, w, out);
+    }
   }
 }
 

@@ -98,10 +98,11 @@ class Demultiplexer {
   // projector-major as tileDirections() reads them; copied, no allocation.
   [[nodiscard]] Result<void> fixTileDirections(std::span<const TileDirection> tiles);
 
-  // Debug view of the last projector separated by run() (or by separateOnly()): its
+  // Debug view of the last projector separated by run() (or chosen by separateOnly()): its
   // colour-normalised derivative per channel (Q4.11 of the local average colour).
   [[nodiscard]] ImageView<const std::int16_t> separated(int channel) const;
-  // Repeats stages 3–5 of the last run() for one projector, so that its debug views can be read.
+  // Makes separated() show this projector's planes from the last run() (which keeps every
+  // projector's).
   [[nodiscard]] Result<void> separateOnly(int projector);
 
  private:
@@ -115,8 +116,8 @@ class Demultiplexer {
   std::span<demux::TileInterp> columns_;
   std::span<demux::TileInterp> rows_;
   std::span<std::int16_t> rowScratch_;
-  std::span<std::int32_t> derivativeRows_;      // separate()'s row of derivatives
   std::span<std::int32_t> filterRows_;          // separate()'s ring of filtered rows
+  std::span<std::int16_t> workRows_;            // separate()'s rows of derivatives, units, tiles
   std::span<std::uint32_t> tileHistograms_;     // tileCount × 64 bins
   std::span<std::int32_t> tileMoments_;         // tileCount × 64 first moments per bin
   std::span<std::uint32_t> tileColourSums_;     // tileCount × 3
@@ -125,9 +126,12 @@ class Demultiplexer {
   std::span<TileDirection> tileDirections_;     // projectors × tileCount
   bool fixedDirections_ = false;                // fixTileDirections() was called
   std::array<ImageView<std::int16_t>, 3> smoothed_;
-  std::array<ImageView<std::int16_t>, 3> separated_;
+  // Per projector; the last projector's planes share smoothed_'s memory (separate() reads each
+  // smoothed row before it writes there).
+  std::array<std::array<ImageView<std::int16_t>, 3>, kMaxProjectors> separated_;
+  std::array<ImageView<std::uint8_t>, kMaxProjectors> order_;
+  int shownProjector_ = 0;  // the projector separated() shows
   ImageView<std::uint16_t> strength_;
-  ImageView<std::uint8_t> order_;
   std::array<BoundaryPlane, kMaxProjectors> boundaries_;
   std::array<DirectionPlane, kMaxProjectors> directions_;
 };
