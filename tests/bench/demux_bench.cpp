@@ -169,7 +169,7 @@ class Stages {
     kern::inverseTileColours(tileSums_, layout_, layout_.params.normaliseColour, tileInverse_);
   }
   void histogram() {
-    kern::histogramTiles(smoothed_.views, layout_, tileHistograms_, tileMoments_);
+    kern::histogramTiles(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
   }
   void directions() {
     kern::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,

@@ -137,7 +137,10 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
   if (!fixedDirections_) {
-    demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
+    // separate()'s filter rows are free until it runs.
+    static_assert(demux::kHistogramRows <= demux::kFilterRows);
+    demux::histogramTiles(smoothed_, layout_, demux::RowBlock(filterRows_, layout_.width),
+                          tileHistograms_, tileMoments_);
     demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
                               tileScratch_);
   }

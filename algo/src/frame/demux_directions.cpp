@@ -265,6 +265,40 @@ void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> p
   }
 }
 
+// histogramTiles()' working rows: the vertical prefilter and first derivative of a sample row,
+// then the gradient (2 × ∂S) and its squared norm along it.
+enum HistogramRow : std::size_t { kVertPre, kVertD1, kGradX, kGradY, kNorm2 };
+
+// The matched 5-tap gradient (as separate() steers it) at every x in [2, width − 3] of row y,
+// filtered vertically first, then horizontally: each row filter is shared by the samples around
+// it, and the sums are those of the 5×5 kernel in another order, hence exact and equal.
+void gradientRow(ImageView<const std::int16_t> plane, int y, const RowBlock& rows) {
+  const int w = plane.width();
+  const std::int16_t* r0 = plane.rowPtr(y - 2);
+  const std::int16_t* r1 = plane.rowPtr(y - 1);
+  const std::int16_t* r2 = plane.rowPtr(y);
+  const std::int16_t* r3 = plane.rowPtr(y + 1);
+  const std::int16_t* r4 = plane.rowPtr(y + 2);
+  std::int32_t* __restrict pre = rows.row(kVertPre);
+  std::int32_t* __restrict d1 = rows.row(kVertD1);
+  for (int x = 0; x < w; ++x) {
+    pre[x] = kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x];
+    d1[x] = kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x]);
+  }
+  std::int32_t* __restrict gx = rows.row(kGradX);
+  std::int32_t* __restrict gy = rows.row(kGradY);
+  std::int32_t* __restrict norm2 = rows.row(kNorm2);
+  for (int x = 2; x + 2 < w; ++x) {
+    const std::int32_t accX =
+        kD1[3] * (pre[x + 1] - pre[x - 1]) + kD1[4] * (pre[x + 2] - pre[x - 2]);
+    const std::int32_t accY =
+        kPre[0] * (d1[x - 2] + d1[x + 2]) + kPre[1] * (d1[x - 1] + d1[x + 1]) + kPre[2] * d1[x];
+    gx[x] = accX >> kDerivShift;
+    gy[x] = accY >> kDerivShift;
+    norm2[x] = gx[x] * gx[x] + gy[x] * gy[x];
+  }
+}
+
 }  // namespace
 
 SampleGrid sampleGrid(const DemuxLayout& layout) {
@@ -272,55 +306,46 @@ SampleGrid sampleGrid(const DemuxLayout& layout) {
   return {s, (layout.width + s - 1) / s, (layout.height + s - 1) / s};
 }
 
-void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
+void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout, const RowBlock& rows,
                     std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments) {
   const SampleGrid grid = sampleGrid(layout);
   const int w = layout.width;
   const int h = layout.height;
+  const int s = grid.stride;
   const int t = layout.params.tilePx;
-  const int tilesX = layout.tilesX();
+  const auto tilesX = static_cast<std::size_t>(layout.tilesX());
   const std::int32_t minGrad = layout.params.minGradientGrey * 2 * kSmoothScale;
-  const auto minNorm2 = static_cast<std::uint32_t>(minGrad * minGrad);
+  const std::int32_t minNorm2 = minGrad * minGrad;
   for (auto& bin : tileHistograms) {
     bin = 0;
   }
   for (auto& moment : tileMoments) {
     moment = 0;
   }
-  for (int sy = 0; sy < grid.height; ++sy) {
-    const int y = sy * grid.stride;
-    for (int sx = 0; sx < grid.width; ++sx) {
-      const int x = sx * grid.stride;
-      if (x < 2 || y < 2 || x + 2 >= w || y + 2 >= h) {
-        continue;
-      }
-      const std::size_t tile = static_cast<std::size_t>(y / t) * static_cast<std::size_t>(tilesX) +
-                               static_cast<std::size_t>(x / t);
-      std::uint32_t* hist = tileHistograms.data() + tile * kBins;
-      std::int32_t* moments = tileMoments.data() + tile * kBins;
-      for (std::size_t c = 0; c < 3; ++c) {
-        // The matched 5-tap gradient (as separate() steers it), scaled to 2 × ∂S.
-        std::int32_t accX = 0;
-        std::int32_t accY = 0;
-        for (std::size_t k = 0; k < 5; ++k) {
-          const std::int16_t* row = smoothed[c].rowPtr(y + static_cast<int>(k) - 2) + x;
-          const std::int32_t pre =
-              kPre[0] * (row[-2] + row[2]) + kPre[1] * (row[-1] + row[1]) + kPre[2] * row[0];
-          const std::int32_t d1 = kD1[3] * (row[1] - row[-1]) + kD1[4] * (row[2] - row[-2]);
-          accX += kPre[k] * d1;
-          accY += kD1[k] * pre;
+  // Samples whose 5×5 support lies inside the image: x, y in [2, size − 3], multiples of s.
+  const int first = (2 + s - 1) / s * s;
+  for (int y = first; y + 2 < h; y += s) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      gradientRow(smoothed[c], y, rows);
+      const std::int32_t* gx = rows.row(kGradX);
+      const std::int32_t* gy = rows.row(kGradY);
+      const std::int32_t* norm2 = rows.row(kNorm2);
+      std::size_t tile = static_cast<std::size_t>(y / t) * tilesX;
+      int tileEnd = t;
+      for (int x = first; x + 2 < w; x += s) {
+        while (x >= tileEnd) {
+          tileEnd += t;
+          ++tile;
         }
-        const std::int32_t gx = accX >> kDerivShift;
-        const std::int32_t gy = accY >> kDerivShift;
-        const auto norm2 = static_cast<std::uint32_t>(gx * gx + gy * gy);
-        if (norm2 < minNorm2) {
+        if (norm2[x] < minNorm2) {
           continue;
         }
-        const auto weight = static_cast<std::int32_t>(isqrt(norm2));
-        const std::uint16_t angle = atan2(gy, gx).doubled().raw;
+        const auto weight = static_cast<std::int32_t>(isqrt(static_cast<std::uint32_t>(norm2[x])));
+        const std::uint16_t angle = atan2(gy[x], gx[x]).doubled().raw;
         const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
-        hist[bin] += static_cast<std::uint32_t>(weight);
-        moments[bin] += weight * wrapDiff(angle, static_cast<std::uint16_t>(bin * kBinRaw));
+        tileHistograms[tile * kBins + bin] += static_cast<std::uint32_t>(weight);
+        tileMoments[tile * kBins + bin] +=
+            weight * wrapDiff(angle, static_cast<std::uint16_t>(bin * kBinRaw));
       }
     }
   }

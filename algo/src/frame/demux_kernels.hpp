@@ -62,6 +62,25 @@ void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t
 void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& layout,
                         bool normalise, std::span<std::uint32_t> inverse);
 
+// Rows of int32 values of one width, carved from the arena: the working rows of histogramTiles()
+// and separate().
+class RowBlock {
+ public:
+  RowBlock() = default;
+  RowBlock(std::span<std::int32_t> memory, int width)
+      : memory_(memory), width_(static_cast<std::size_t>(width)) {}
+  [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
+    return rows * static_cast<std::size_t>(width);
+  }
+  [[nodiscard]] std::int32_t* row(std::size_t index) const {
+    return memory_.data() + index * width_;
+  }
+
+ private:
+  std::span<std::int32_t> memory_;
+  std::size_t width_ = 0;
+};
+
 // Stage 2a: each tile's histogram of its samples' doubled gradient angles (weights per bin and
 // first moments Σ w·(angle − bin centre) per bin).
 struct SampleGrid {
@@ -70,7 +89,9 @@ struct SampleGrid {
   int height = 0;  // sample rows
 };
 [[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
-void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
+// rows: kHistogramRows working rows of the image's width (run() lends separate()'s).
+inline constexpr std::size_t kHistogramRows = 5;
+void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout, const RowBlock& rows,
                     std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments);
 
 // Stage 2b: lobes of each tile's window histogram matched to the predicted directions, then a
@@ -91,24 +112,6 @@ struct TileInterp {
   std::int16_t nearest;
 };
 void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
-
-// Rows of int32 values of one width, carved from the arena: separate()'s working rows.
-class RowBlock {
- public:
-  RowBlock() = default;
-  RowBlock(std::span<std::int32_t> memory, int width)
-      : memory_(memory), width_(static_cast<std::size_t>(width)) {}
-  [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
-    return rows * static_cast<std::size_t>(width);
-  }
-  [[nodiscard]] std::int32_t* row(std::size_t index) const {
-    return memory_.data() + index * width_;
-  }
-
- private:
-  std::span<std::int32_t> memory_;
-  std::size_t width_ = 0;
-};
 
 // The ring of horizontally filtered rows separate() streams through: 5 slots (rows y − 2 … y + 2)
 // × 3 channels × (prefilter, first, second derivative).
