@@ -65,7 +65,8 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(carveSpan(carver, units_, 1));
   step(carveSpan(carver, columns_, static_cast<std::size_t>(l.width)));
   step(carveSpan(carver, rows_, static_cast<std::size_t>(l.height)));
-  step(carveSpan(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
+  step(
+      carveSpan(carver, rowScratch_, demux::kSmoothRowScratch * static_cast<std::size_t>(l.width)));
   step(carveSpan(carver, filterRows_, demux::RowBlock::valuesFor(demux::kFilterRows, l.width)));
   step(carveSpan(carver, derivativeRows_,
                  demux::RowBlock::valuesFor(demux::kDerivativeRows, l.width)));

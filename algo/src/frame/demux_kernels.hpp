@@ -51,7 +51,8 @@ inline constexpr int kDerivShift = 15;  // filter scale / 2: D values are 2 × t
 using Planes3 = std::array<ImageView<std::int16_t>, 3>;
 
 // Stage 1: S_c = 16 × I_c smoothed by `passes` 3×3 binomial passes (edges repeated; 0 passes:
-// unsmoothed). rowScratch holds 2 × width values.
+// unsmoothed). rowScratch holds kSmoothRowScratch × width values.
+inline constexpr std::size_t kSmoothRowScratch = 3;
 void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch);
 

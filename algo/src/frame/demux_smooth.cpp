@@ -12,13 +12,44 @@ namespace smx::algo::demux {
 namespace {
 
 template <int Channel>
-void copyChannel(ConstRgbView image, ImageView<std::int16_t> out, int scale) {
+void copyChannel(ConstRgbView image, ImageView<std::int16_t> out) {
   for (int y = 0; y < image.height(); ++y) {
-    const Rgb8* src = image.rowPtr(y);
+    const std::uint8_t* src = &image.rowPtr(y)->r + Channel;
     std::int16_t* dst = out.rowPtr(y);
     for (int x = 0; x < image.width(); ++x) {
-      const std::uint8_t* p = &src[x].r;
-      dst[x] = static_cast<std::int16_t>(scale * p[Channel]);
+      dst[x] = static_cast<std::int16_t>(kSmoothScale * src[3 * x]);
+    }
+  }
+}
+
+// The first [1 2 1]ᵀ[1 2 1] pass straight from the RGB rows (edges repeated): 0…255 to
+// 16 × grey, exact, so no rounding. The vertical sum runs over the interleaved row (contiguous,
+// so it vectorises); the horizontal one splits the channels. vertical holds 3 × width values.
+void firstPass(ConstRgbView image, const Planes3& out, std::int16_t* __restrict vertical) {
+  const int w = image.width();
+  const int h = image.height();
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* above = &image.rowPtr(y > 0 ? y - 1 : 0)->r;
+    const std::uint8_t* centre = &image.rowPtr(y)->r;
+    const std::uint8_t* below = &image.rowPtr(y + 1 < h ? y + 1 : h - 1)->r;
+    for (int i = 0; i < 3 * w; ++i) {
+      vertical[i] = static_cast<std::int16_t>(above[i] + 2 * centre[i] + below[i]);
+    }
+    std::int16_t* __restrict r = out[0].rowPtr(y);
+    std::int16_t* __restrict g = out[1].rowPtr(y);
+    std::int16_t* __restrict b = out[2].rowPtr(y);
+    for (int x = 1; x + 1 < w; ++x) {
+      const std::int16_t* v = vertical + 3 * x;
+      r[x] = static_cast<std::int16_t>(v[-3] + 2 * v[0] + v[3]);
+      g[x] = static_cast<std::int16_t>(v[-2] + 2 * v[1] + v[4]);
+      b[x] = static_cast<std::int16_t>(v[-1] + 2 * v[2] + v[5]);
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::int16_t* v = vertical + c;
+      std::int16_t* dst = out[c].rowPtr(y);
+      const int right = 3 * (w - 1);
+      dst[0] = static_cast<std::int16_t>(3 * v[0] + v[w > 1 ? 3 : 0]);
+      dst[w - 1] = static_cast<std::int16_t>(v[w > 1 ? right - 3 : 0] + 3 * v[right]);
     }
   }
 }
@@ -64,15 +95,18 @@ void binomialPass(ImageView<std::int16_t> plane, int shift, std::int16_t* prev, 
 
 void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch) {
-  const int scale = passes > 0 ? 1 : kSmoothScale;
-  copyChannel<0>(image, out[0], scale);
-  copyChannel<1>(image, out[1], scale);
-  copyChannel<2>(image, out[2], scale);
+  if (passes == 0) {
+    copyChannel<0>(image, out[0]);
+    copyChannel<1>(image, out[1]);
+    copyChannel<2>(image, out[2]);
+    return;
+  }
+  firstPass(image, out, rowScratch.data());
   const auto w = static_cast<std::size_t>(image.width());
   for (const auto& plane : out) {
-    for (int pass = 0; pass < passes; ++pass) {
-      // The first pass takes 0…255 to 16 × grey; later ones keep that scale.
-      binomialPass(plane, pass == 0 ? 0 : 4, rowScratch.data(), rowScratch.data() + w);
+    for (int pass = 1; pass < passes; ++pass) {
+      // Later passes keep the scale of 16 × grey.
+      binomialPass(plane, 4, rowScratch.data(), rowScratch.data() + w);
     }
   }
 }
