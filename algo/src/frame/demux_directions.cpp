@@ -38,7 +38,7 @@ struct Lobe {
 // Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
 // the bins within ±kRefineBins of the current centre, exact from each bin's weight and first
 // moment (Σ w·(angle − bin centre)).
-Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
+Lobe refine(int peakBin, const std::uint32_t (&weights)[kBins],
             const std::int64_t (&moments)[kBins]) {
   Lobe lobe;
   std::int32_t centre = peakBin * kBinRaw;  // unwrapped doubled angle
@@ -60,9 +60,10 @@ Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
   return lobe;
 }
 
-// Sums of tile histograms (weights and first moments, 64 bits) over a set of tiles.
+// Sums of tile histograms over a set of tiles: first moments in 64 bits; weights in 32 (a tile's
+// bin holds at most 81 samples × 3 channels of weight < 2^14, a window at most 81 tiles).
 struct BinSums {
-  std::uint64_t weights[kBins] = {};
+  std::uint32_t weights[kBins] = {};
   std::int64_t moments[kBins] = {};
 
   void clear() {
@@ -212,12 +213,35 @@ void forEachTile(const ProjectorTiles& tiles, Fix fix) {
   }
 }
 
+void sort2(std::int32_t& a, std::int32_t& b) {
+  const std::int32_t low = a < b ? a : b;
+  b = a < b ? b : a;
+  a = low;
+}
+
+// The median of 9 values: a 19-exchange selection network (Paeth's; checked on every 0/1 input),
+// branch-free where sorting mispredicts.
+std::int32_t median9(std::int32_t (&p)[9]) {
+  sort2(p[1], p[2]), sort2(p[4], p[5]), sort2(p[7], p[8]);
+  sort2(p[0], p[1]), sort2(p[3], p[4]), sort2(p[6], p[7]);
+  sort2(p[1], p[2]), sort2(p[4], p[5]), sort2(p[7], p[8]);
+  sort2(p[0], p[3]), sort2(p[5], p[8]), sort2(p[4], p[7]);
+  sort2(p[3], p[6]), sort2(p[1], p[4]), sort2(p[2], p[5]);
+  sort2(p[4], p[7]), sort2(p[4], p[2]), sort2(p[6], p[4]);
+  sort2(p[4], p[2]);
+  return p[4];
+}
+
 // Tile estimates scatter by a few degrees where lobes are broad (three patterns) and single tiles
 // go astray; the field itself varies slowly. Each found tile takes the median offset from the
-// prediction over the found tiles of its 3×3 neighbourhood (through scratch, so that every
-// median sees unfiltered neighbours).
+// prediction over the found tiles of its 3×3 neighbourhood (the upper median of an even count;
+// through scratch, so that every median sees unfiltered neighbours). The neighbourhood's missing
+// tiles count as below or above everything, as many below as keep the median of 9 on the found
+// tiles' median.
 void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
                        std::span<TileDirection> out, std::span<std::uint16_t> scratch) {
+  constexpr std::int32_t kBelowAll = -65536;
+  constexpr std::int32_t kAboveAll = 65536;
   for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
     const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
     forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
@@ -225,17 +249,14 @@ void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t>
       if (tiles.tiles[t].present == 0) {
         return;
       }
-      std::int32_t offsets[9] = {};  // the tile itself is found: count >= 1
+      std::int32_t values[9];
       int count = 0;
-      tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) {
-        int k = count++;  // insertion into the sorted prefix
-        for (; k > 0 && offsets[k - 1] > value; --k) {
-          offsets[k] = offsets[k - 1];
-        }
-        offsets[k] = value;
-      });
+      tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) { values[count++] = value; });
+      for (int k = count, below = (9 - count) / 2; k < 9; ++k, --below) {
+        values[k] = below > 0 ? kBelowAll : kAboveAll;
+      }
       scratch[t] = static_cast<std::uint16_t>(tiles.prediction(t) +
-                                              static_cast<std::uint16_t>(offsets[count / 2]));
+                                              static_cast<std::uint16_t>(median9(values)));
     });
     for (std::size_t t = 0; t < tiles.tiles.size(); ++t) {
       tiles.tiles[t].angle = scratch[t];
@@ -379,19 +400,26 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       for (const std::uint64_t weight : hist) {
         total += weight;
       }
-      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4).
+      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4), each the
+      // first maximum of its two halves' first maxima.
       Lobe lobes[kMaxLobes];
       int lobeCount = 0;
       int peakBins[kMaxLobes];
       if (total > 0) {
-        for (int aw = 0; aw < 8; ++aw) {
-          const int start = aw * (kBins / 8);
-          int best = start;
-          for (int k = start; k < start + kBins / 4; ++k) {
-            if (hist[k % kBins] > hist[best % kBins]) {
-              best = k;
-            }
+        constexpr int kHalf = kBins / 8;
+        int halfBest[8];
+        for (int b = 0; b < 8; ++b) {
+          int best = b * kHalf;
+          for (int k = best + 1; k < (b + 1) * kHalf; ++k) {
+            best = hist[k] > hist[best] ? k : best;
           }
+          halfBest[b] = best;
+        }
+        for (int aw = 0; aw < 8; ++aw) {
+          const int start = aw * kHalf;
+          const int upper = halfBest[(aw + 1) % 8];
+          const int best =
+              hist[upper] > hist[halfBest[aw]] ? start + kHalf + upper % kHalf : halfBest[aw];
           if (best == start || best == start + kBins / 4 - 1 || hist[best % kBins] == 0) {
             continue;
           }
