@@ -288,12 +288,33 @@ void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> p
 
 // histogramTiles()' working rows: the vertical prefilter and first derivative of a sample row,
 // then the gradient (2 × ∂S) and its squared norm along it.
-enum HistogramRow : std::size_t { kVertPre, kVertD1, kGradX, kGradY, kNorm2 };
+enum HistogramRow : std::size_t { kVertPre, kVertD1, kGradX, kGradY };
 
-// The matched 5-tap gradient (as separate() steers it) at every x in [2, width − 3] of row y,
-// filtered vertically first, then horizontally: each row filter is shared by the samples around
-// it, and the sums are those of the 5×5 kernel in another order, hence exact and equal.
-void gradientRow(ImageView<const std::int16_t> plane, int y, const RowBlock& rows) {
+// The horizontal halves of the gradient at the samples x = first + i·step, i < count, into
+// gx[i] and gy[i] (Step > 0 fixes the step at compile time, where the loop vectorises).
+template <int Step>
+void horizontalPass(const RowBlock& rows, int first, int step, int count) {
+  const int s = Step > 0 ? Step : step;
+  const std::int32_t* __restrict pre = rows.row(kVertPre) + first;
+  const std::int32_t* __restrict d1 = rows.row(kVertD1) + first;
+  std::int32_t* __restrict gx = rows.row(kGradX);
+  std::int32_t* __restrict gy = rows.row(kGradY);
+  for (int i = 0; i < count; ++i) {
+    const int x = i * s;
+    const std::int32_t accX =
+        kD1[3] * (pre[x + 1] - pre[x - 1]) + kD1[4] * (pre[x + 2] - pre[x - 2]);
+    const std::int32_t accY =
+        kPre[0] * (d1[x - 2] + d1[x + 2]) + kPre[1] * (d1[x - 1] + d1[x + 1]) + kPre[2] * d1[x];
+    gx[i] = accX >> kDerivShift;
+    gy[i] = accY >> kDerivShift;
+  }
+}
+
+// The matched 5-tap gradient (as separate() steers it) at the samples of row y, filtered
+// vertically first, then horizontally: each row filter is shared by the samples around it, and
+// the sums are those of the 5×5 kernel in another order, hence exact and equal.
+void gradientRow(ImageView<const std::int16_t> plane, int y, int first, int step, int count,
+                 const RowBlock& rows) {
   const int w = plane.width();
   const std::int16_t* r0 = plane.rowPtr(y - 2);
   const std::int16_t* r1 = plane.rowPtr(y - 1);
@@ -306,17 +327,10 @@ void gradientRow(ImageView<const std::int16_t> plane, int y, const RowBlock& row
     pre[x] = kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x];
     d1[x] = kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x]);
   }
-  std::int32_t* __restrict gx = rows.row(kGradX);
-  std::int32_t* __restrict gy = rows.row(kGradY);
-  std::int32_t* __restrict norm2 = rows.row(kNorm2);
-  for (int x = 2; x + 2 < w; ++x) {
-    const std::int32_t accX =
-        kD1[3] * (pre[x + 1] - pre[x - 1]) + kD1[4] * (pre[x + 2] - pre[x - 2]);
-    const std::int32_t accY =
-        kPre[0] * (d1[x - 2] + d1[x + 2]) + kPre[1] * (d1[x - 1] + d1[x + 1]) + kPre[2] * d1[x];
-    gx[x] = accX >> kDerivShift;
-    gy[x] = accY >> kDerivShift;
-    norm2[x] = gx[x] * gx[x] + gy[x] * gy[x];
+  if (step == 2) {
+    horizontalPass<2>(rows, first, step, count);
+  } else {
+    horizontalPass<0>(rows, first, step, count);
   }
 }
 
@@ -345,24 +359,26 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout, const Ro
   }
   // Samples whose 5×5 support lies inside the image: x, y in [2, size − 3], multiples of s.
   const int first = (2 + s - 1) / s * s;
+  const int count = w - 2 > first ? (w - 3 - first) / s + 1 : 0;
   for (int y = first; y + 2 < h; y += s) {
     for (std::size_t c = 0; c < 3; ++c) {
-      gradientRow(smoothed[c], y, rows);
+      gradientRow(smoothed[c], y, first, s, count, rows);
       const std::int32_t* gx = rows.row(kGradX);
       const std::int32_t* gy = rows.row(kGradY);
-      const std::int32_t* norm2 = rows.row(kNorm2);
       std::size_t tile = static_cast<std::size_t>(y / t) * tilesX;
       int tileEnd = t;
-      for (int x = first; x + 2 < w; x += s) {
+      for (int i = 0; i < count; ++i) {
+        const int x = first + i * s;
         while (x >= tileEnd) {
           tileEnd += t;
           ++tile;
         }
-        if (norm2[x] < minNorm2) {
+        const std::int32_t norm2 = gx[i] * gx[i] + gy[i] * gy[i];
+        if (norm2 < minNorm2) {
           continue;
         }
-        const auto weight = static_cast<std::int32_t>(isqrt(static_cast<std::uint32_t>(norm2[x])));
-        const std::uint16_t angle = atan2(gy[x], gx[x]).doubled().raw;
+        const auto weight = static_cast<std::int32_t>(isqrt(static_cast<std::uint32_t>(norm2)));
+        const std::uint16_t angle = atan2(gy[i], gx[i]).doubled().raw;
         const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
         tileHistograms[tile * kBins + bin] += static_cast<std::uint32_t>(weight);
         tileMoments[tile * kBins + bin] +=

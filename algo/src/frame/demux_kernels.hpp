@@ -91,7 +91,7 @@ struct SampleGrid {
 };
 [[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
 // rows: kHistogramRows working rows of the image's width (run() lends separate()'s).
-inline constexpr std::size_t kHistogramRows = 5;
+inline constexpr std::size_t kHistogramRows = 4;
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout, const RowBlock& rows,
                     std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments);
 
