@@ -30,9 +30,8 @@ constexpr int kMaxLobes = 8;
 constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
 struct Lobe {
-  std::uint64_t weight = 0;  // histogram mass within ±kShareBins of the peak
   std::uint16_t angle2 = 0;  // refined doubled angle
-  bool used = false;
+  bool used = false;         // matched, or holding too small a share to match
 };
 
 // Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
@@ -132,10 +131,9 @@ class WindowSums {
   // Tile column i's histograms over the tile rows ty − r … ty + r inside the grid.
   void sumColumn(int i, BinSums& column) const {
     column.clear();
-    for (int j = ty_ - radius_; j <= ty_ + radius_; ++j) {
-      if (j < 0 || j >= tilesY_) {
-        continue;
-      }
+    const int j0 = ty_ - radius_ > 0 ? ty_ - radius_ : 0;
+    const int j1 = ty_ + radius_ < tilesY_ ? ty_ + radius_ : tilesY_ - 1;
+    for (int j = j0; j <= j1; ++j) {
       const std::size_t offset = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
                                   static_cast<std::size_t>(i)) *
                                  kBins;
@@ -179,13 +177,14 @@ struct ProjectorTiles {
   // Calls visit(offset from the prediction) for each found tile within ±radius of (tx, ty).
   template <class Visit>
   void forEachFoundAround(int tx, int ty, int radius, Visit visit) const {
-    for (int j = ty - radius; j <= ty + radius; ++j) {
-      for (int i = tx - radius; i <= tx + radius; ++i) {
-        if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-          continue;
-        }
-        const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
-                       static_cast<std::size_t>(i);
+    const int i0 = tx - radius > 0 ? tx - radius : 0;
+    const int i1 = tx + radius < tilesX ? tx + radius : tilesX - 1;
+    const int j0 = ty - radius > 0 ? ty - radius : 0;
+    const int j1 = ty + radius < tilesY ? ty + radius : tilesY - 1;
+    for (int j = j0; j <= j1; ++j) {
+      const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX);
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t n = row + static_cast<std::size_t>(i);
         if (tiles[n].present != 0) {
           visit(wrapDiff(tiles[n].angle, prediction(n)));
         }
@@ -455,7 +454,8 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
           for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
             mass += hist[(k + kBins) % kBins];
           }
-          lobes[lobeCount].weight = mass;
+          // A lobe below the minimum share of the window's weight never matches.
+          lobes[lobeCount].used = mass * 100 < minSharePct * total;
           ++lobeCount;
         }
       }
@@ -500,7 +500,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
               predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
           const auto pred2 = static_cast<std::uint16_t>(pred << 1U);
           for (int l = 0; l < lobeCount; ++l) {
-            if (lobes[l].used || lobes[l].weight * 100 < minSharePct * total) {
+            if (lobes[l].used) {
               continue;
             }
             std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
