@@ -111,25 +111,56 @@ void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
   }
 }
 
+namespace {
+
+// Σ of the plane over each tile of one tile row, into tileRow[tx * 3]: per column over the rows
+// first (lane-wise adds, where TilePx > 0 fixes the width at compile time and they vectorise), one
+// reduction per tile.
+template <int TilePx>
+void sumTileRow(ImageView<const std::int16_t> plane, int y0, int y1, int tilePx,
+                std::uint32_t* tileRow) {
+  const int w = plane.width();
+  const int t = TilePx > 0 ? TilePx : tilePx;
+  for (int x0 = 0, tx = 0; x0 < w; x0 += t, ++tx) {
+    const int n = x0 + t <= w ? t : w - x0;
+    std::uint32_t acc = 0;
+    if (TilePx > 0 && n == TilePx) {
+      std::uint32_t lanes[TilePx > 0 ? std::size_t{TilePx} : 1] = {};
+      for (int y = y0; y < y1; ++y) {
+        const std::int16_t* row = plane.rowPtr(y) + x0;
+        for (int x = 0; x < TilePx; ++x) {
+          lanes[static_cast<std::size_t>(x)] += static_cast<std::uint32_t>(row[x]);
+        }
+      }
+      for (const std::uint32_t lane : lanes) {
+        acc += lane;
+      }
+    } else {
+      for (int y = y0; y < y1; ++y) {
+        const std::int16_t* row = plane.rowPtr(y) + x0;
+        for (int x = 0; x < n; ++x) {
+          acc += static_cast<std::uint32_t>(row[x]);
+        }
+      }
+    }
+    tileRow[static_cast<std::size_t>(tx) * 3] = acc;
+  }
+}
+
+}  // namespace
+
 void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t> sums) {
   const int w = smoothed[0].width();
   const int h = smoothed[0].height();
-  const int tilesX = (w + tilePx - 1) / tilePx;
-  for (auto& s : sums) {
-    s = 0;
-  }
-  for (int c = 0; c < 3; ++c) {
-    for (int y = 0; y < h; ++y) {
-      const std::int16_t* row = smoothed[static_cast<std::size_t>(c)].rowPtr(y);
-      std::uint32_t* tileRow =
-          sums.data() + static_cast<std::size_t>(y / tilePx) * static_cast<std::size_t>(tilesX) * 3;
-      for (int tx = 0; tx < tilesX; ++tx) {
-        const int x1 = tx * tilePx + tilePx < w ? tx * tilePx + tilePx : w;
-        std::uint32_t acc = 0;
-        for (int x = tx * tilePx; x < x1; ++x) {
-          acc += static_cast<std::uint32_t>(row[x]);
-        }
-        tileRow[static_cast<std::size_t>(tx) * 3 + static_cast<std::size_t>(c)] += acc;
+  const auto tilesX = static_cast<std::size_t>((w + tilePx - 1) / tilePx);
+  for (std::size_t c = 0; c < 3; ++c) {
+    for (int y0 = 0, ty = 0; y0 < h; y0 += tilePx, ++ty) {
+      const int y1 = y0 + tilePx < h ? y0 + tilePx : h;
+      std::uint32_t* tileRow = sums.data() + static_cast<std::size_t>(ty) * tilesX * 3 + c;
+      if (tilePx == 8) {
+        sumTileRow<8>(smoothed[c], y0, y1, tilePx, tileRow);
+      } else {
+        sumTileRow<0>(smoothed[c], y0, y1, tilePx, tileRow);
       }
     }
   }
