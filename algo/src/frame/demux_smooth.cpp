@@ -184,13 +184,16 @@ void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& 
         }
         continue;
       }
-      std::uint64_t acc[3] = {0, 0, 0};
-      std::uint64_t pixels = 0;
-      for (int j = ty - r; j <= ty + r; ++j) {
-        for (int i = tx - r; i <= tx + r; ++i) {
-          if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-            continue;
-          }
+      // 32 bits hold a window's sums (81 tiles of 64 × 64 × 4080 < 2^31), and its division is
+      // cheaper.
+      std::uint32_t acc[3] = {0, 0, 0};
+      std::uint32_t pixels = 0;
+      const int i0 = tx - r > 0 ? tx - r : 0;
+      const int i1 = tx + r < tilesX ? tx + r : tilesX - 1;
+      const int j0 = ty - r > 0 ? ty - r : 0;
+      const int j1 = ty + r < tilesY ? ty + r : tilesY - 1;
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
           const auto in = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
                            static_cast<std::size_t>(i)) *
                           3;
@@ -199,16 +202,15 @@ void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& 
           }
           const int tw = (i + 1) * t <= layout.width ? t : layout.width - i * t;
           const int th = (j + 1) * t <= layout.height ? t : layout.height - j * t;
-          pixels += static_cast<std::uint64_t>(tw) * static_cast<std::uint64_t>(th);
+          pixels += static_cast<std::uint32_t>(tw * th);
         }
       }
       for (std::size_t c = 0; c < 3; ++c) {
-        std::uint64_t average = pixels > 0 ? acc[c] / pixels : 0;
+        std::uint32_t average = pixels > 0 ? acc[c] / pixels : 0;
         if (average < kColourFloor) {
           average = kColourFloor;
         }
-        inverse[out + c] =
-            static_cast<std::uint32_t>((std::uint64_t{1} << kInverseShift) / average);
+        inverse[out + c] = (1U << kInverseShift) / average;
       }
     }
   }
