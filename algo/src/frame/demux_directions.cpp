@@ -130,20 +130,27 @@ class WindowSums {
   BinSums& slot(int tileX) { return columns_[static_cast<std::size_t>(tileX % (2 * radius_ + 1))]; }
   // Tile column i's histograms over the tile rows ty − r … ty + r inside the grid.
   void sumColumn(int i, BinSums& column) const {
-    column.clear();
     const int j0 = ty_ - radius_ > 0 ? ty_ - radius_ : 0;
     const int j1 = ty_ + radius_ < tilesY_ ? ty_ + radius_ : tilesY_ - 1;
-    for (int j = j0; j <= j1; ++j) {
-      const std::size_t offset = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
-                                  static_cast<std::size_t>(i)) *
-                                 kBins;
-      const std::uint32_t* weights = histograms_.data() + offset;
-      const std::int32_t* moments = moments_.data() + offset;
+    const std::uint32_t* weights = histograms_.data() + offset(i, j0);
+    const std::int32_t* moments = moments_.data() + offset(i, j0);
+    for (int k = 0; k < kBins; ++k) {
+      column.weights[k] = weights[k];
+      column.moments[k] = moments[k];
+    }
+    for (int j = j0 + 1; j <= j1; ++j) {
+      weights = histograms_.data() + offset(i, j);
+      moments = moments_.data() + offset(i, j);
       for (int k = 0; k < kBins; ++k) {
         column.weights[k] += weights[k];
         column.moments[k] += moments[k];
       }
     }
+  }
+  [[nodiscard]] std::size_t offset(int i, int j) const {
+    return (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
+            static_cast<std::size_t>(i)) *
+           kBins;
   }
 
   std::span<const std::uint32_t> histograms_;
