@@ -133,7 +133,7 @@ class Stages {
         w_(layout.width),
         h_(layout.height),
         smoothed_(w_, h_),
-        rowScratch_(2 * static_cast<std::size_t>(w_)),
+        rowScratch_(kern::kSmoothRowScratch * static_cast<std::size_t>(w_)),
         tileSums_(layout.tileCount() * 3),
         tileInverse_(layout.tileCount() * 3),
         tileHistograms_(layout.tileCount() * kern::kBins),
@@ -171,7 +171,7 @@ class Stages {
     kern::inverseTileColours(tileSums_, layout_, layout_.params.normaliseColour, tileInverse_);
   }
   void histogram() {
-    kern::histogramTiles(smoothed_.views, layout_, tileHistograms_, tileMoments_);
+    kern::histogramTiles(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
   }
   void directions() {
     kern::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,

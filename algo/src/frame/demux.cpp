@@ -65,7 +65,8 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(carveSpan(carver, units_, 1));
   step(carveSpan(carver, columns_, static_cast<std::size_t>(l.width)));
   step(carveSpan(carver, rows_, static_cast<std::size_t>(l.height)));
-  step(carveSpan(carver, rowScratch_, 2 * static_cast<std::size_t>(l.width)));
+  step(
+      carveSpan(carver, rowScratch_, demux::kSmoothRowScratch * static_cast<std::size_t>(l.width)));
   step(carveSpan(carver, filterRows_,
                  demux::RowBlock<std::int32_t>::valuesFor(demux::kFilterRows, l.width)));
   step(carveSpan(carver, workRows_,
@@ -142,7 +143,11 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
   if (!fixedDirections_) {
-    demux::histogramTiles(smoothed_, layout_, tileHistograms_, tileMoments_);
+    // separate()'s filter rows are free until it runs.
+    static_assert(demux::kHistogramRows <= demux::kFilterRows);
+    demux::histogramTiles(smoothed_, layout_,
+                          demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
+                          tileHistograms_, tileMoments_);
     demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
                               tileScratch_);
   }

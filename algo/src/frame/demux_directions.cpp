@@ -30,15 +30,14 @@ constexpr int kMaxLobes = 8;
 constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
 struct Lobe {
-  std::uint64_t weight = 0;  // histogram mass within ±kShareBins of the peak
   std::uint16_t angle2 = 0;  // refined doubled angle
-  bool used = false;
+  bool used = false;         // matched, or holding too small a share to match
 };
 
 // Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
 // the bins within ±kRefineBins of the current centre, exact from each bin's weight and first
 // moment (Σ w·(angle − bin centre)).
-Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
+Lobe refine(int peakBin, const std::uint32_t (&weights)[kBins],
             const std::int64_t (&moments)[kBins]) {
   Lobe lobe;
   std::int32_t centre = peakBin * kBinRaw;  // unwrapped doubled angle
@@ -60,9 +59,10 @@ Lobe refine(int peakBin, const std::uint64_t (&weights)[kBins],
   return lobe;
 }
 
-// Sums of tile histograms (weights and first moments, 64 bits) over a set of tiles.
+// Sums of tile histograms over a set of tiles: first moments in 64 bits; weights in 32 (a tile's
+// bin holds at most 81 samples × 3 channels of weight < 2^14, a window at most 81 tiles).
 struct BinSums {
-  std::uint64_t weights[kBins] = {};
+  std::uint32_t weights[kBins] = {};
   std::int64_t moments[kBins] = {};
 
   void clear() {
@@ -130,21 +130,27 @@ class WindowSums {
   BinSums& slot(int tileX) { return columns_[static_cast<std::size_t>(tileX % (2 * radius_ + 1))]; }
   // Tile column i's histograms over the tile rows ty − r … ty + r inside the grid.
   void sumColumn(int i, BinSums& column) const {
-    column.clear();
-    for (int j = ty_ - radius_; j <= ty_ + radius_; ++j) {
-      if (j < 0 || j >= tilesY_) {
-        continue;
-      }
-      const std::size_t offset = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
-                                  static_cast<std::size_t>(i)) *
-                                 kBins;
-      const std::uint32_t* weights = histograms_.data() + offset;
-      const std::int32_t* moments = moments_.data() + offset;
+    const int j0 = ty_ - radius_ > 0 ? ty_ - radius_ : 0;
+    const int j1 = ty_ + radius_ < tilesY_ ? ty_ + radius_ : tilesY_ - 1;
+    const std::uint32_t* weights = histograms_.data() + offset(i, j0);
+    const std::int32_t* moments = moments_.data() + offset(i, j0);
+    for (int k = 0; k < kBins; ++k) {
+      column.weights[k] = weights[k];
+      column.moments[k] = moments[k];
+    }
+    for (int j = j0 + 1; j <= j1; ++j) {
+      weights = histograms_.data() + offset(i, j);
+      moments = moments_.data() + offset(i, j);
       for (int k = 0; k < kBins; ++k) {
         column.weights[k] += weights[k];
         column.moments[k] += moments[k];
       }
     }
+  }
+  [[nodiscard]] std::size_t offset(int i, int j) const {
+    return (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX_) +
+            static_cast<std::size_t>(i)) *
+           kBins;
   }
 
   std::span<const std::uint32_t> histograms_;
@@ -178,13 +184,14 @@ struct ProjectorTiles {
   // Calls visit(offset from the prediction) for each found tile within ±radius of (tx, ty).
   template <class Visit>
   void forEachFoundAround(int tx, int ty, int radius, Visit visit) const {
-    for (int j = ty - radius; j <= ty + radius; ++j) {
-      for (int i = tx - radius; i <= tx + radius; ++i) {
-        if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-          continue;
-        }
-        const auto n = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
-                       static_cast<std::size_t>(i);
+    const int i0 = tx - radius > 0 ? tx - radius : 0;
+    const int i1 = tx + radius < tilesX ? tx + radius : tilesX - 1;
+    const int j0 = ty - radius > 0 ? ty - radius : 0;
+    const int j1 = ty + radius < tilesY ? ty + radius : tilesY - 1;
+    for (int j = j0; j <= j1; ++j) {
+      const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX);
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t n = row + static_cast<std::size_t>(i);
         if (tiles[n].present != 0) {
           visit(wrapDiff(tiles[n].angle, prediction(n)));
         }
@@ -212,12 +219,35 @@ void forEachTile(const ProjectorTiles& tiles, Fix fix) {
   }
 }
 
+void sort2(std::int32_t& a, std::int32_t& b) {
+  const std::int32_t low = a < b ? a : b;
+  b = a < b ? b : a;
+  a = low;
+}
+
+// The median of 9 values: a 19-exchange selection network (Paeth's; checked on every 0/1 input),
+// branch-free where sorting mispredicts.
+std::int32_t median9(std::int32_t (&p)[9]) {
+  sort2(p[1], p[2]), sort2(p[4], p[5]), sort2(p[7], p[8]);
+  sort2(p[0], p[1]), sort2(p[3], p[4]), sort2(p[6], p[7]);
+  sort2(p[1], p[2]), sort2(p[4], p[5]), sort2(p[7], p[8]);
+  sort2(p[0], p[3]), sort2(p[5], p[8]), sort2(p[4], p[7]);
+  sort2(p[3], p[6]), sort2(p[1], p[4]), sort2(p[2], p[5]);
+  sort2(p[4], p[7]), sort2(p[4], p[2]), sort2(p[6], p[4]);
+  sort2(p[4], p[2]);
+  return p[4];
+}
+
 // Tile estimates scatter by a few degrees where lobes are broad (three patterns) and single tiles
 // go astray; the field itself varies slowly. Each found tile takes the median offset from the
-// prediction over the found tiles of its 3×3 neighbourhood (through scratch, so that every
-// median sees unfiltered neighbours).
+// prediction over the found tiles of its 3×3 neighbourhood (the upper median of an even count;
+// through scratch, so that every median sees unfiltered neighbours). The neighbourhood's missing
+// tiles count as below or above everything, as many below as keep the median of 9 on the found
+// tiles' median.
 void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
                        std::span<TileDirection> out, std::span<std::uint16_t> scratch) {
+  constexpr std::int32_t kBelowAll = -65536;
+  constexpr std::int32_t kAboveAll = 65536;
   for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
     const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
     forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
@@ -225,17 +255,14 @@ void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t>
       if (tiles.tiles[t].present == 0) {
         return;
       }
-      std::int32_t offsets[9] = {};  // the tile itself is found: count >= 1
+      std::int32_t values[9];
       int count = 0;
-      tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) {
-        int k = count++;  // insertion into the sorted prefix
-        for (; k > 0 && offsets[k - 1] > value; --k) {
-          offsets[k] = offsets[k - 1];
-        }
-        offsets[k] = value;
-      });
+      tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) { values[count++] = value; });
+      for (int k = count, below = (9 - count) / 2; k < 9; ++k, --below) {
+        values[k] = below > 0 ? kBelowAll : kAboveAll;
+      }
       scratch[t] = static_cast<std::uint16_t>(tiles.prediction(t) +
-                                              static_cast<std::uint16_t>(offsets[count / 2]));
+                                              static_cast<std::uint16_t>(median9(values)));
     });
     for (std::size_t t = 0; t < tiles.tiles.size(); ++t) {
       tiles.tiles[t].angle = scratch[t];
@@ -265,6 +292,54 @@ void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> p
   }
 }
 
+// histogramTiles()' working rows: the vertical prefilter and first derivative of a sample row,
+// then the gradient (2 × ∂S) and its squared norm along it.
+enum HistogramRow : std::size_t { kVertPre, kVertD1, kGradX, kGradY };
+
+// The horizontal halves of the gradient at the samples x = first + i·step, i < count, into
+// gx[i] and gy[i] (Step > 0 fixes the step at compile time, where the loop vectorises).
+template <int Step>
+void horizontalPass(const RowBlock<std::int32_t>& rows, int first, int step, int count) {
+  const int s = Step > 0 ? Step : step;
+  const std::int32_t* __restrict pre = rows.row(kVertPre) + first;
+  const std::int32_t* __restrict d1 = rows.row(kVertD1) + first;
+  std::int32_t* __restrict gx = rows.row(kGradX);
+  std::int32_t* __restrict gy = rows.row(kGradY);
+  for (int i = 0; i < count; ++i) {
+    const int x = i * s;
+    const std::int32_t accX =
+        kD1[3] * (pre[x + 1] - pre[x - 1]) + kD1[4] * (pre[x + 2] - pre[x - 2]);
+    const std::int32_t accY =
+        kPre[0] * (d1[x - 2] + d1[x + 2]) + kPre[1] * (d1[x - 1] + d1[x + 1]) + kPre[2] * d1[x];
+    gx[i] = accX >> kDerivShift;
+    gy[i] = accY >> kDerivShift;
+  }
+}
+
+// The matched 5-tap gradient (as separate() steers it) at the samples of row y, filtered
+// vertically first, then horizontally: each row filter is shared by the samples around it, and
+// the sums are those of the 5×5 kernel in another order, hence exact and equal.
+void gradientRow(ImageView<const std::int16_t> plane, int y, int first, int step, int count,
+                 const RowBlock<std::int32_t>& rows) {
+  const int w = plane.width();
+  const std::int16_t* r0 = plane.rowPtr(y - 2);
+  const std::int16_t* r1 = plane.rowPtr(y - 1);
+  const std::int16_t* r2 = plane.rowPtr(y);
+  const std::int16_t* r3 = plane.rowPtr(y + 1);
+  const std::int16_t* r4 = plane.rowPtr(y + 2);
+  std::int32_t* __restrict pre = rows.row(kVertPre);
+  std::int32_t* __restrict d1 = rows.row(kVertD1);
+  for (int x = 0; x < w; ++x) {
+    pre[x] = kPre[0] * (r0[x] + r4[x]) + kPre[1] * (r1[x] + r3[x]) + kPre[2] * r2[x];
+    d1[x] = kD1[3] * (r3[x] - r1[x]) + kD1[4] * (r4[x] - r0[x]);
+  }
+  if (step == 2) {
+    horizontalPass<2>(rows, first, step, count);
+  } else {
+    horizontalPass<0>(rows, first, step, count);
+  }
+}
+
 }  // namespace
 
 SampleGrid sampleGrid(const DemuxLayout& layout) {
@@ -273,54 +348,48 @@ SampleGrid sampleGrid(const DemuxLayout& layout) {
 }
 
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
-                    std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments) {
+                    const RowBlock<std::int32_t>& rows, std::span<std::uint32_t> tileHistograms,
+                    std::span<std::int32_t> tileMoments) {
   const SampleGrid grid = sampleGrid(layout);
   const int w = layout.width;
   const int h = layout.height;
+  const int s = grid.stride;
   const int t = layout.params.tilePx;
-  const int tilesX = layout.tilesX();
+  const auto tilesX = static_cast<std::size_t>(layout.tilesX());
   const std::int32_t minGrad = layout.params.minGradientGrey * 2 * kSmoothScale;
-  const auto minNorm2 = static_cast<std::uint32_t>(minGrad * minGrad);
+  const std::int32_t minNorm2 = minGrad * minGrad;
   for (auto& bin : tileHistograms) {
     bin = 0;
   }
   for (auto& moment : tileMoments) {
     moment = 0;
   }
-  for (int sy = 0; sy < grid.height; ++sy) {
-    const int y = sy * grid.stride;
-    for (int sx = 0; sx < grid.width; ++sx) {
-      const int x = sx * grid.stride;
-      if (x < 2 || y < 2 || x + 2 >= w || y + 2 >= h) {
-        continue;
-      }
-      const std::size_t tile = static_cast<std::size_t>(y / t) * static_cast<std::size_t>(tilesX) +
-                               static_cast<std::size_t>(x / t);
-      std::uint32_t* hist = tileHistograms.data() + tile * kBins;
-      std::int32_t* moments = tileMoments.data() + tile * kBins;
-      for (std::size_t c = 0; c < 3; ++c) {
-        // The matched 5-tap gradient (as separate() steers it), scaled to 2 × ∂S.
-        std::int32_t accX = 0;
-        std::int32_t accY = 0;
-        for (std::size_t k = 0; k < 5; ++k) {
-          const std::int16_t* row = smoothed[c].rowPtr(y + static_cast<int>(k) - 2) + x;
-          const std::int32_t pre =
-              kPre[0] * (row[-2] + row[2]) + kPre[1] * (row[-1] + row[1]) + kPre[2] * row[0];
-          const std::int32_t d1 = kD1[3] * (row[1] - row[-1]) + kD1[4] * (row[2] - row[-2]);
-          accX += kPre[k] * d1;
-          accY += kD1[k] * pre;
+  // Samples whose 5×5 support lies inside the image: x, y in [2, size − 3], multiples of s.
+  const int first = (2 + s - 1) / s * s;
+  const int count = w - 2 > first ? (w - 3 - first) / s + 1 : 0;
+  for (int y = first; y + 2 < h; y += s) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      gradientRow(smoothed[c], y, first, s, count, rows);
+      const std::int32_t* gx = rows.row(kGradX);
+      const std::int32_t* gy = rows.row(kGradY);
+      std::size_t tile = static_cast<std::size_t>(y / t) * tilesX;
+      int tileEnd = t;
+      for (int i = 0; i < count; ++i) {
+        const int x = first + i * s;
+        while (x >= tileEnd) {
+          tileEnd += t;
+          ++tile;
         }
-        const std::int32_t gx = accX >> kDerivShift;
-        const std::int32_t gy = accY >> kDerivShift;
-        const auto norm2 = static_cast<std::uint32_t>(gx * gx + gy * gy);
+        const std::int32_t norm2 = gx[i] * gx[i] + gy[i] * gy[i];
         if (norm2 < minNorm2) {
           continue;
         }
-        const auto weight = static_cast<std::int32_t>(isqrt(norm2));
-        const std::uint16_t angle = atan2(gy, gx).doubled().raw;
+        const auto weight = static_cast<std::int32_t>(isqrt(static_cast<std::uint32_t>(norm2)));
+        const std::uint16_t angle = atan2(gy[i], gx[i]).doubled().raw;
         const auto bin = static_cast<std::size_t>(((angle + kBinRaw / 2) / kBinRaw) % kBins);
-        hist[bin] += static_cast<std::uint32_t>(weight);
-        moments[bin] += weight * wrapDiff(angle, static_cast<std::uint16_t>(bin * kBinRaw));
+        tileHistograms[tile * kBins + bin] += static_cast<std::uint32_t>(weight);
+        tileMoments[tile * kBins + bin] +=
+            weight * wrapDiff(angle, static_cast<std::uint16_t>(bin * kBinRaw));
       }
     }
   }
@@ -354,19 +423,26 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       for (const std::uint64_t weight : hist) {
         total += weight;
       }
-      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4).
+      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4), each the
+      // first maximum of its two halves' first maxima.
       Lobe lobes[kMaxLobes];
       int lobeCount = 0;
       int peakBins[kMaxLobes];
       if (total > 0) {
-        for (int aw = 0; aw < 8; ++aw) {
-          const int start = aw * (kBins / 8);
-          int best = start;
-          for (int k = start; k < start + kBins / 4; ++k) {
-            if (hist[k % kBins] > hist[best % kBins]) {
-              best = k;
-            }
+        constexpr int kHalf = kBins / 8;
+        int halfBest[8];
+        for (int b = 0; b < 8; ++b) {
+          int best = b * kHalf;
+          for (int k = best + 1; k < (b + 1) * kHalf; ++k) {
+            best = hist[k] > hist[best] ? k : best;
           }
+          halfBest[b] = best;
+        }
+        for (int aw = 0; aw < 8; ++aw) {
+          const int start = aw * kHalf;
+          const int upper = halfBest[(aw + 1) % 8];
+          const int best =
+              hist[upper] > hist[halfBest[aw]] ? start + kHalf + upper % kHalf : halfBest[aw];
           if (best == start || best == start + kBins / 4 - 1 || hist[best % kBins] == 0) {
             continue;
           }
@@ -386,7 +462,8 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
           for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
             mass += hist[(k + kBins) % kBins];
           }
-          lobes[lobeCount].weight = mass;
+          // A lobe below the minimum share of the window's weight never matches.
+          lobes[lobeCount].used = mass * 100 < minSharePct * total;
           ++lobeCount;
         }
       }
@@ -431,7 +508,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
               predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
           const auto pred2 = static_cast<std::uint16_t>(pred << 1U);
           for (int l = 0; l < lobeCount; ++l) {
-            if (lobes[l].used || lobes[l].weight * 100 < minSharePct * total) {
+            if (lobes[l].used) {
               continue;
             }
             std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);

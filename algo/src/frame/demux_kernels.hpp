@@ -51,7 +51,8 @@ inline constexpr int kDerivShift = 15;  // filter scale / 2: D values are 2 × t
 using Planes3 = std::array<ImageView<std::int16_t>, 3>;
 
 // Stage 1: S_c = 16 × I_c smoothed by `passes` 3×3 binomial passes (edges repeated; 0 passes:
-// unsmoothed). rowScratch holds 2 × width values.
+// unsmoothed). rowScratch holds kSmoothRowScratch × width values.
+inline constexpr std::size_t kSmoothRowScratch = 3;
 void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch);
 
@@ -62,6 +63,24 @@ void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t
 void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& layout,
                         bool normalise, std::span<std::uint32_t> inverse);
 
+// Rows of values of one width, carved from the arena: the working rows of histogramTiles() and
+// separate().
+template <class T>
+class RowBlock {
+ public:
+  RowBlock() = default;
+  RowBlock(std::span<T> memory, int width)
+      : memory_(memory), width_(static_cast<std::size_t>(width)) {}
+  [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
+    return rows * static_cast<std::size_t>(width);
+  }
+  [[nodiscard]] T* row(std::size_t index) const { return memory_.data() + index * width_; }
+
+ private:
+  std::span<T> memory_;
+  std::size_t width_ = 0;
+};
+
 // Stage 2a: each tile's histogram of its samples' doubled gradient angles (weights per bin and
 // first moments Σ w·(angle − bin centre) per bin).
 struct SampleGrid {
@@ -70,8 +89,11 @@ struct SampleGrid {
   int height = 0;  // sample rows
 };
 [[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
+// rows: kHistogramRows working rows of the image's width (run() lends separate()'s).
+inline constexpr std::size_t kHistogramRows = 4;
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
-                    std::span<std::uint32_t> tileHistograms, std::span<std::int32_t> tileMoments);
+                    const RowBlock<std::int32_t>& rows, std::span<std::uint32_t> tileHistograms,
+                    std::span<std::int32_t> tileMoments);
 
 // Stage 2b: lobes of each tile's window histogram matched to the predicted directions, then a
 // 3×3 median of the found tiles' offsets from the prediction; tiles without the lobe take their
@@ -91,23 +113,6 @@ struct TileInterp {
   std::int16_t nearest;
 };
 void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> out);
-
-// Rows of values of one width, carved from the arena: separate()'s working rows.
-template <class T>
-class RowBlock {
- public:
-  RowBlock() = default;
-  RowBlock(std::span<T> memory, int width)
-      : memory_(memory), width_(static_cast<std::size_t>(width)) {}
-  [[nodiscard]] static std::size_t valuesFor(std::size_t rows, int width) {
-    return rows * static_cast<std::size_t>(width);
-  }
-  [[nodiscard]] T* row(std::size_t index) const { return memory_.data() + index * width_; }
-
- private:
-  std::span<T> memory_;
-  std::size_t width_ = 0;
-};
 
 // separate()'s rows: a ring of horizontally filtered rows (int32; 5 rows × 3 channels × 3
 // filters) and the current row's derivatives, unit vectors and tile data (int16).

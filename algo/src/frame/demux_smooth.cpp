@@ -12,13 +12,44 @@ namespace smx::algo::demux {
 namespace {
 
 template <int Channel>
-void copyChannel(ConstRgbView image, ImageView<std::int16_t> out, int scale) {
+void copyChannel(ConstRgbView image, ImageView<std::int16_t> out) {
   for (int y = 0; y < image.height(); ++y) {
-    const Rgb8* src = image.rowPtr(y);
+    const std::uint8_t* src = &image.rowPtr(y)->r + Channel;
     std::int16_t* dst = out.rowPtr(y);
     for (int x = 0; x < image.width(); ++x) {
-      const std::uint8_t* p = &src[x].r;
-      dst[x] = static_cast<std::int16_t>(scale * p[Channel]);
+      dst[x] = static_cast<std::int16_t>(kSmoothScale * src[3 * x]);
+    }
+  }
+}
+
+// The first [1 2 1]ᵀ[1 2 1] pass straight from the RGB rows (edges repeated): 0…255 to
+// 16 × grey, exact, so no rounding. The vertical sum runs over the interleaved row (contiguous,
+// so it vectorises); the horizontal one splits the channels. vertical holds 3 × width values.
+void firstPass(ConstRgbView image, const Planes3& out, std::int16_t* __restrict vertical) {
+  const int w = image.width();
+  const int h = image.height();
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* above = &image.rowPtr(y > 0 ? y - 1 : 0)->r;
+    const std::uint8_t* centre = &image.rowPtr(y)->r;
+    const std::uint8_t* below = &image.rowPtr(y + 1 < h ? y + 1 : h - 1)->r;
+    for (int i = 0; i < 3 * w; ++i) {
+      vertical[i] = static_cast<std::int16_t>(above[i] + 2 * centre[i] + below[i]);
+    }
+    std::int16_t* __restrict r = out[0].rowPtr(y);
+    std::int16_t* __restrict g = out[1].rowPtr(y);
+    std::int16_t* __restrict b = out[2].rowPtr(y);
+    for (int x = 1; x + 1 < w; ++x) {
+      const std::int16_t* v = vertical + 3 * x;
+      r[x] = static_cast<std::int16_t>(v[-3] + 2 * v[0] + v[3]);
+      g[x] = static_cast<std::int16_t>(v[-2] + 2 * v[1] + v[4]);
+      b[x] = static_cast<std::int16_t>(v[-1] + 2 * v[2] + v[5]);
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::int16_t* v = vertical + c;
+      std::int16_t* dst = out[c].rowPtr(y);
+      const int right = 3 * (w - 1);
+      dst[0] = static_cast<std::int16_t>(3 * v[0] + v[w > 1 ? 3 : 0]);
+      dst[w - 1] = static_cast<std::int16_t>(v[w > 1 ? right - 3 : 0] + 3 * v[right]);
     }
   }
 }
@@ -64,38 +95,72 @@ void binomialPass(ImageView<std::int16_t> plane, int shift, std::int16_t* prev, 
 
 void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
                     std::span<std::int16_t> rowScratch) {
-  const int scale = passes > 0 ? 1 : kSmoothScale;
-  copyChannel<0>(image, out[0], scale);
-  copyChannel<1>(image, out[1], scale);
-  copyChannel<2>(image, out[2], scale);
+  if (passes == 0) {
+    copyChannel<0>(image, out[0]);
+    copyChannel<1>(image, out[1]);
+    copyChannel<2>(image, out[2]);
+    return;
+  }
+  firstPass(image, out, rowScratch.data());
   const auto w = static_cast<std::size_t>(image.width());
   for (const auto& plane : out) {
-    for (int pass = 0; pass < passes; ++pass) {
-      // The first pass takes 0…255 to 16 × grey; later ones keep that scale.
-      binomialPass(plane, pass == 0 ? 0 : 4, rowScratch.data(), rowScratch.data() + w);
+    for (int pass = 1; pass < passes; ++pass) {
+      // Later passes keep the scale of 16 × grey.
+      binomialPass(plane, 4, rowScratch.data(), rowScratch.data() + w);
     }
   }
 }
 
+namespace {
+
+// Σ of the plane over each tile of one tile row, into tileRow[tx * 3]: per column over the rows
+// first (lane-wise adds, where TilePx > 0 fixes the width at compile time and they vectorise), one
+// reduction per tile.
+template <int TilePx>
+void sumTileRow(ImageView<const std::int16_t> plane, int y0, int y1, int tilePx,
+                std::uint32_t* tileRow) {
+  const int w = plane.width();
+  const int t = TilePx > 0 ? TilePx : tilePx;
+  for (int x0 = 0, tx = 0; x0 < w; x0 += t, ++tx) {
+    const int n = x0 + t <= w ? t : w - x0;
+    std::uint32_t acc = 0;
+    if (TilePx > 0 && n == TilePx) {
+      std::uint32_t lanes[TilePx > 0 ? std::size_t{TilePx} : 1] = {};
+      for (int y = y0; y < y1; ++y) {
+        const std::int16_t* row = plane.rowPtr(y) + x0;
+        for (int x = 0; x < TilePx; ++x) {
+          lanes[static_cast<std::size_t>(x)] += static_cast<std::uint32_t>(row[x]);
+        }
+      }
+      for (const std::uint32_t lane : lanes) {
+        acc += lane;
+      }
+    } else {
+      for (int y = y0; y < y1; ++y) {
+        const std::int16_t* row = plane.rowPtr(y) + x0;
+        for (int x = 0; x < n; ++x) {
+          acc += static_cast<std::uint32_t>(row[x]);
+        }
+      }
+    }
+    tileRow[static_cast<std::size_t>(tx) * 3] = acc;
+  }
+}
+
+}  // namespace
+
 void sumTileColours(const Planes3& smoothed, int tilePx, std::span<std::uint32_t> sums) {
   const int w = smoothed[0].width();
   const int h = smoothed[0].height();
-  const int tilesX = (w + tilePx - 1) / tilePx;
-  for (auto& s : sums) {
-    s = 0;
-  }
-  for (int c = 0; c < 3; ++c) {
-    for (int y = 0; y < h; ++y) {
-      const std::int16_t* row = smoothed[static_cast<std::size_t>(c)].rowPtr(y);
-      std::uint32_t* tileRow =
-          sums.data() + static_cast<std::size_t>(y / tilePx) * static_cast<std::size_t>(tilesX) * 3;
-      for (int tx = 0; tx < tilesX; ++tx) {
-        const int x1 = tx * tilePx + tilePx < w ? tx * tilePx + tilePx : w;
-        std::uint32_t acc = 0;
-        for (int x = tx * tilePx; x < x1; ++x) {
-          acc += static_cast<std::uint32_t>(row[x]);
-        }
-        tileRow[static_cast<std::size_t>(tx) * 3 + static_cast<std::size_t>(c)] += acc;
+  const auto tilesX = static_cast<std::size_t>((w + tilePx - 1) / tilePx);
+  for (std::size_t c = 0; c < 3; ++c) {
+    for (int y0 = 0, ty = 0; y0 < h; y0 += tilePx, ++ty) {
+      const int y1 = y0 + tilePx < h ? y0 + tilePx : h;
+      std::uint32_t* tileRow = sums.data() + static_cast<std::size_t>(ty) * tilesX * 3 + c;
+      if (tilePx == 8) {
+        sumTileRow<8>(smoothed[c], y0, y1, tilePx, tileRow);
+      } else {
+        sumTileRow<0>(smoothed[c], y0, y1, tilePx, tileRow);
       }
     }
   }
@@ -119,13 +184,16 @@ void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& 
         }
         continue;
       }
-      std::uint64_t acc[3] = {0, 0, 0};
-      std::uint64_t pixels = 0;
-      for (int j = ty - r; j <= ty + r; ++j) {
-        for (int i = tx - r; i <= tx + r; ++i) {
-          if (i < 0 || j < 0 || i >= tilesX || j >= tilesY) {
-            continue;
-          }
+      // 32 bits hold a window's sums (81 tiles of 64 × 64 × 4080 < 2^31), and its division is
+      // cheaper.
+      std::uint32_t acc[3] = {0, 0, 0};
+      std::uint32_t pixels = 0;
+      const int i0 = tx - r > 0 ? tx - r : 0;
+      const int i1 = tx + r < tilesX ? tx + r : tilesX - 1;
+      const int j0 = ty - r > 0 ? ty - r : 0;
+      const int j1 = ty + r < tilesY ? ty + r : tilesY - 1;
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
           const auto in = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
                            static_cast<std::size_t>(i)) *
                           3;
@@ -134,16 +202,15 @@ void inverseTileColours(std::span<const std::uint32_t> sums, const DemuxLayout& 
           }
           const int tw = (i + 1) * t <= layout.width ? t : layout.width - i * t;
           const int th = (j + 1) * t <= layout.height ? t : layout.height - j * t;
-          pixels += static_cast<std::uint64_t>(tw) * static_cast<std::uint64_t>(th);
+          pixels += static_cast<std::uint32_t>(tw * th);
         }
       }
       for (std::size_t c = 0; c < 3; ++c) {
-        std::uint64_t average = pixels > 0 ? acc[c] / pixels : 0;
+        std::uint32_t average = pixels > 0 ? acc[c] / pixels : 0;
         if (average < kColourFloor) {
           average = kColourFloor;
         }
-        inverse[out + c] =
-            static_cast<std::uint32_t>((std::uint64_t{1} << kInverseShift) / average);
+        inverse[out + c] = (1U << kInverseShift) / average;
       }
     }
   }
