@@ -188,10 +188,11 @@ class Stages {
   }
   void boundaries() {
     for (ProjectorOut& out : projectors_) {
-      kern::detectBoundaries(
-          out.separated.views, viewOf(std::span<const std::uint8_t>(out.order), w_, h_),
-          viewOf(std::span<const std::uint16_t>(out.direction), w_, h_), units_, minStrength_,
-          viewOf(std::span(strength_), w_, h_), viewOf(std::span(out.boundaries), w_, h_));
+      kern::detectBoundaries(out.separated.views,
+                             viewOf(std::span<const std::uint8_t>(out.order), w_, h_),
+                             viewOf(std::span<const std::uint16_t>(out.direction), w_, h_), units_,
+                             minStrength_, workRows_, viewOf(std::span(strength_), w_, h_),
+                             viewOf(std::span(out.boundaries), w_, h_));
     }
   }
   void all(algo::ConstRgbView image) {

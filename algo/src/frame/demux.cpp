@@ -161,9 +161,12 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
                   std::span<const DirectionPlane>(directions_.data(), projectors),
                   std::span<const demux::Planes3>(separated_.data(), projectors),
                   std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
+  // separate() is done with its working rows: they hold detectBoundaries()' ring.
+  static_assert(demux::kBoundaryRingRows <= demux::kWorkRows);
   for (std::size_t q = 0; q < projectors; ++q) {
-    demux::detectBoundaries(separated_[q], order_[q], directions_[q], units_[0],
-                            demux::minStrengthQ11(p), strength_, boundaries_[q]);
+    demux::detectBoundaries(
+        separated_[q], order_[q], directions_[q], units_[0], demux::minStrengthQ11(p),
+        demux::RowBlock<std::int16_t>(workRows_, layout_.width), strength_, boundaries_[q]);
   }
   shownProjector_ = layout_.projectors - 1;
   return {};

@@ -296,29 +296,21 @@ void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTa
 }
 
 // The second-order samples (behind per channel, then ahead per channel) of the last rows the
-// strength pass computed, kept for the maxima found three rows later, in the output plane's
-// last rows, which are written only after every row kept here is done with: row y's six int16
-// rows fill three Boundary rows, slot y mod 4. Rows too near the bottom are not kept (their
-// maxima sample again), nor anything when the image is too small.
+// strength pass computed, kept for the maxima found three rows later: row y's six rows in slot
+// y mod kBoundaryRingSlots.
 class SampleRing {
  public:
-  static constexpr int kSlots = 4;
-  static constexpr int kRows = kSlots * 3;
+  explicit SampleRing(const RowBlock<std::int16_t>& rows) : rows_(rows) {}
 
-  explicit SampleRing(BoundaryPlane out) : out_(out) {}
-
-  [[nodiscard]] bool holds(int y) const { return y < out_.height() - kRows; }
   // Sample j (0–5) of pixel x of row y.
-  [[nodiscard]] std::byte* at(int y, int j, int x) const {
-    const int index = (y % kSlots) * 6 + j;
-    auto* row = reinterpret_cast<std::byte*>(out_.rowPtr(out_.height() - kRows + index / 2));
-    const auto half = static_cast<std::size_t>(out_.width()) * sizeof(std::int16_t);
-    return row + static_cast<std::size_t>(index % 2) * half +
-           static_cast<std::size_t>(x) * sizeof(std::int16_t);
+  [[nodiscard]] std::int16_t* at(int y, int j, int x) const {
+    const std::size_t slot = static_cast<std::size_t>(y) % kBoundaryRingSlots;
+    return rows_.row(slot * kSamplesPerPixel + static_cast<std::size_t>(j)) + x;
   }
 
  private:
-  BoundaryPlane out_;
+  static constexpr std::size_t kSamplesPerPixel = kBoundaryRingRows / kBoundaryRingSlots;
+  RowBlock<std::int16_t> rows_;
 };
 
 // One chunk [x0, x0 + n) of a strength row: max − min over the channels of the response, where
@@ -352,7 +344,7 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   if (anySecond == 0) {
     return;
   }
-  ChunkTaps taps;
+  ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
   chunkTaps(d, units, n, taps);
   std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
   forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
@@ -368,11 +360,8 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     const std::int32_t lo = std::min({n0, n1, n2});
     s[i] = o[i] == 2 ? saturateStrength(hi - lo) : s[i];
   }
-  if (ring.holds(y)) {
-    for (int j = 0; j < 6; ++j) {
-      std::memcpy(ring.at(y, j, x0), samples[j],
-                  static_cast<std::size_t>(n) * sizeof(std::int16_t));
-    }
+  for (int j = 0; j < 6; ++j) {
+    std::copy_n(samples[j], n, ring.at(y, j, x0));
   }
 }
 
@@ -404,13 +393,6 @@ struct Candidate {
   std::int32_t behind;
 };
 
-// A sample kept in the ring: bytes of the Boundary plane, so read by memcpy, not through a cast.
-std::int32_t kept(const std::byte* sample) {
-  std::int16_t v = 0;
-  std::memcpy(&v, sample, sizeof v);
-  return v;
-}
-
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
 Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, std::uint8_t order,
                     std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
@@ -439,16 +421,10 @@ Boundary boundaryAt(const SeparatedRow& row, ImageView<const std::uint16_t> st, 
   } else {
     Response behindSamples{};
     Response aheadSamples{};
-    if (ring.holds(y)) {
-      for (int channel = 0; channel < 3; ++channel) {
-        const auto k = static_cast<std::size_t>(channel);
-        behindSamples.n[k] = kept(ring.at(y, channel, x));
-        aheadSamples.n[k] = kept(ring.at(y, 3 + channel, x));
-      }
-    } else {
-      const TapPair taps = tapsAlong(ux, uy, 6);
-      behindSamples = row.samples(x, taps.behind);
-      aheadSamples = row.samples(x, taps.ahead);
+    for (int channel = 0; channel < 3; ++channel) {
+      const auto k = static_cast<std::size_t>(channel);
+      behindSamples.n[k] = *ring.at(y, channel, x);
+      aheadSamples.n[k] = *ring.at(y, 3 + channel, x);
     }
     found = classify(secondOrderResponse(behindSamples, aheadSamples));
     if (order == 2) {
@@ -477,9 +453,9 @@ void maximaChunk(const SeparatedRow& row, ImageView<const std::uint16_t> st, con
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
   const std::uint16_t* s = st.rowPtr(y) + x0;
-  ChunkTaps taps;
+  ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
   chunkTaps(d + x0, units, n, taps);
-  ChunkSamples samples;
+  ChunkSamples samples;  // NOLINT(cppcoreguidelines-pro-type-member-init): filled next
   strengthSamples(s, strideOf(st), taps, n, samples);
   alignas(8) std::uint8_t isMax[kChunkPx] = {};
   for (int i = 0; i < n; ++i) {
@@ -551,16 +527,17 @@ void maximaRow(const Planes3& separated, ImageView<const std::uint8_t> order,
 
 // Row y's maxima read the strength up to row y + 3 (the 2×2 of a sample two pixels below).
 constexpr int kStrengthAhead = 3;
-static_assert(kStrengthAhead < SampleRing::kSlots);
+static_assert(static_cast<std::size_t>(kStrengthAhead) < kBoundaryRingSlots);
 
 }  // namespace
 
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
                       ConstDirectionPlane direction, const UnitTable& units, int minStrength,
-                      ImageView<std::uint16_t> strength, BoundaryPlane out) {
+                      const RowBlock<std::int16_t>& ringRows, ImageView<std::uint16_t> strength,
+                      BoundaryPlane out) {
   const int h = separated[0].height();
   const UnitsQ8 unitsQ8(units);
-  const SampleRing ring(out);
+  const SampleRing ring(ringRows);
   // Row by row, the maxima kStrengthAhead rows behind the strength, while the samples they
   // reuse are still in the ring (and the rows in cache).
   for (int y = 0; y < h + kStrengthAhead; ++y) {

@@ -147,9 +147,14 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
 }
 
 // Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
-// suppression along the encoding direction, sub-pixel offset and class.
+// suppression along the encoding direction, sub-pixel offset and class. ringRows: a ring of
+// kBoundaryRingRows working rows of the image's width (run() lends separate()'s) keeping the
+// second-order samples of the last kBoundaryRingSlots strength rows for their maxima.
+inline constexpr std::size_t kBoundaryRingSlots = 4;
+inline constexpr std::size_t kBoundaryRingRows = kBoundaryRingSlots * 6;
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
                       ConstDirectionPlane direction, const UnitTable& units, int minStrength,
-                      ImageView<std::uint16_t> strength, BoundaryPlane out);
+                      const RowBlock<std::int16_t>& ringRows, ImageView<std::uint16_t> strength,
+                      BoundaryPlane out);
 
 }  // namespace smx::algo::demux

@@ -3,6 +3,7 @@
 //   Output  int16 planes, 16 × smoothed grey (0…4080): the 3×3 binomial kernel sums to 16; a
 //           second pass (5×5 binomial overall, σ = 1 px) is rounded back by >> 4.
 //   Accumulators int32 (tile sums uint32: a 64×64 tile of 4080 is < 2^24). Nothing saturates.
+#include <cstddef>
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -17,7 +18,7 @@ void copyChannel(ConstRgbView image, ImageView<std::int16_t> out) {
     const std::uint8_t* src = &image.rowPtr(y)->r + Channel;
     std::int16_t* dst = out.rowPtr(y);
     for (int x = 0; x < image.width(); ++x) {
-      dst[x] = static_cast<std::int16_t>(kSmoothScale * src[3 * x]);
+      dst[x] = static_cast<std::int16_t>(kSmoothScale * src[3 * static_cast<std::ptrdiff_t>(x)]);
     }
   }
 }
@@ -39,7 +40,7 @@ void firstPass(ConstRgbView image, const Planes3& out, std::int16_t* __restrict 
     std::int16_t* __restrict g = out[1].rowPtr(y);
     std::int16_t* __restrict b = out[2].rowPtr(y);
     for (int x = 1; x + 1 < w; ++x) {
-      const std::int16_t* v = vertical + 3 * x;
+      const std::int16_t* v = vertical + 3 * static_cast<std::ptrdiff_t>(x);
       r[x] = static_cast<std::int16_t>(v[-3] + 2 * v[0] + v[3]);
       g[x] = static_cast<std::int16_t>(v[-2] + 2 * v[1] + v[4]);
       b[x] = static_cast<std::int16_t>(v[-1] + 2 * v[2] + v[5]);
