@@ -5,7 +5,7 @@
 //   build/host/tests/bench/demux_digest | diff before.txt -
 // Per rig (rig_2proj_1cam, rig_3proj_1cam) and scene (plane, sphere, rgbcmy_panel, statue,
 // bunny; seed 1, camera 0), per projector: FNV-1a 64 of its boundaries, direction plane and tile
-// directions after run(), and of the three separated planes and after separateOnly(projector).
+// directions and of its three separated planes after run().
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -60,12 +60,9 @@ void digestFrame(const std::string& rig, const std::string& scene) {
     }
     const std::uint64_t boundaries = digestOf(demux.boundaries(p));
     const std::uint64_t directions = digestOf(demux.directions(p));
-    if (auto ok = demux.separateOnly(p); !ok) {
-      throw std::runtime_error(ok.error().message);
-    }
     Fnv64 separated;
     for (int c = 0; c < 3; ++c) {
-      separated.addPlane(demux.separated(c));
+      separated.addPlane(demux.separated(p, c));
     }
     std::printf(
         "%s %s proj%d boundaries %016llx directions %016llx tiles %016llx "

@@ -64,9 +64,6 @@ std::expected<void, Failure> writeDebug(const fs::path& dir, const algo::Camera&
                                         const algo::Rig& rig, algo::CameraPipeline& pipeline) {
   for (int p = 0; p < pipeline.projectors(); ++p) {
     const std::string tag = rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id;
-    if (auto ok = pipeline.demux().separateOnly(p); !ok) {
-      return std::unexpected(Failure{kExitBadInput, ok.error().message});
-    }
     if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
       return ok;
     }

@@ -96,9 +96,6 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
       io.out << "  " << projector.id << ": " << boundaries << " boundary pixels, pattern found in "
              << (100 * present) / layout.tileCount() << " % of the image\n";
       if (opts.debug) {
-        if (auto ok = demux->separateOnly(p); !ok) {
-          return fail(kExitBadInput, ok.error().message);
-        }
         const std::string tag = projector.id + "." + camera.id;
         if (auto ok = writeDemuxDebug(*opts.debug, tag, *demux, p); !ok) {
           return fail(kExitDeviceOrIo, ok.error());

@@ -87,8 +87,8 @@ sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
 std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& dir,
                                                  const std::string& tag,
                                                  const algo::Demultiplexer& demux, int projector) {
-  const algo::ImageView<const std::int16_t> separated[3] = {demux.separated(0), demux.separated(1),
-                                                            demux.separated(2)};
+  const algo::ImageView<const std::int16_t> separated[3] = {
+      demux.separated(projector, 0), demux.separated(projector, 1), demux.separated(projector, 2)};
   const std::pair<const char*, sim::RgbImage> images[] = {
       {".boundaries.png", renderBoundaries(demux.boundaries(projector))},
       {".separated.png", renderSeparated(separated)},

@@ -168,7 +168,6 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
         separated_[q], order_[q], directions_[q], units_[0], demux::minStrengthQ11(p),
         demux::RowBlock<std::int16_t>(workRows_, layout_.width), strength_, boundaries_[q]);
   }
-  shownProjector_ = layout_.projectors - 1;
   return {};
 }
 
@@ -179,14 +178,6 @@ Result<void> Demultiplexer::fixTileDirections(std::span<const TileDirection> til
   }
   std::ranges::copy(tiles, tileDirections_.begin());
   fixedDirections_ = true;
-  return {};
-}
-
-Result<void> Demultiplexer::separateOnly(int projector) {
-  if (projector < 0 || projector >= layout_.projectors) {
-    return fail(Errc::kInvalidArgument, "demux: no such projector");
-  }
-  shownProjector_ = projector;
   return {};
 }
 
@@ -203,8 +194,8 @@ std::span<const TileDirection> Demultiplexer::tileDirections(int projector) cons
                                  layout_.tileCount());
 }
 
-ImageView<const std::int16_t> Demultiplexer::separated(int channel) const {
-  return separated_[static_cast<std::size_t>(shownProjector_)][static_cast<std::size_t>(channel)];
+ImageView<const std::int16_t> Demultiplexer::separated(int projector, int channel) const {
+  return separated_[static_cast<std::size_t>(projector)][static_cast<std::size_t>(channel)];
 }
 
 }  // namespace smx::algo

@@ -98,12 +98,10 @@ class Demultiplexer {
   // projector-major as tileDirections() reads them; copied, no allocation.
   [[nodiscard]] Result<void> fixTileDirections(std::span<const TileDirection> tiles);
 
-  // Debug view of the last projector separated by run() (or chosen by separateOnly()): its
-  // colour-normalised derivative per channel (Q4.11 of the local average colour).
-  [[nodiscard]] ImageView<const std::int16_t> separated(int channel) const;
-  // Makes separated() show this projector's planes from the last run() (which keeps every
-  // projector's).
-  [[nodiscard]] Result<void> separateOnly(int projector);
+  // Debug view of the last run(): the projector's colour-normalised separated derivative per
+  // channel (Q4.11 of the local average colour). The last projector's planes share the smoothed
+  // image's memory, so they hold until the next run().
+  [[nodiscard]] ImageView<const std::int16_t> separated(int projector, int channel) const;
 
  private:
   Demultiplexer() = default;
@@ -130,7 +128,6 @@ class Demultiplexer {
   // smoothed row before it writes there).
   std::array<std::array<ImageView<std::int16_t>, 3>, kMaxProjectors> separated_;
   std::array<ImageView<std::uint8_t>, kMaxProjectors> order_;
-  int shownProjector_ = 0;  // the projector separated() shows
   ImageView<std::uint16_t> strength_;
   std::array<BoundaryPlane, kMaxProjectors> boundaries_;
   std::array<DirectionPlane, kMaxProjectors> directions_;
