@@ -149,17 +149,17 @@ TEST(DemuxAccuracy, TwoPatterns70DegOnAPlaneMeetTheTargets) {
 }
 
 // A sphere before a wall: curved surface, shadows, an occluding contour. Towards the sphere's rim
-// one pattern arrives at grazing incidence and fades: its lobe is lost there (about 6 % of the
+// one pattern arrives at grazing incidence and fades: its lobe is lost there (about 5 % of the
 // region) and the direction is guessed from the tiles around, so the 95th percentile is far off
-// target (ratchet: 15°) while it meets it where the lobe was found;
-// recall, precision and position meet the targets, the class of one projector's boundaries is
-// just under (98.8 %, ratchet 98.5 %).
+// target (ratchet: 10°) while it meets it where the lobe was found; recall, precision, class and
+// position meet the targets (class only since tiles take their own surface's lobe at the contour
+// and found directions grow into the rim: 98.8 % before).
 TEST(DemuxAccuracy, TwoPatternsOnASphere) {
   const auto f = render("rig_2proj_1cam.json", "sphere");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     const Figures both = measure(f, *d->demux, p, 2, "sphere 90deg");
-    expectWithin(both, {1.0, 15.0, 0.98, 0.98, 0.985, 0.15}, "projector " + std::to_string(p));
+    expectWithin(both, {1.0, 10.0, 0.98, 0.98, 0.99, 0.15}, "projector " + std::to_string(p));
     EXPECT_LE(both.directionsFound.p95Deg, 5.0) << "projector " << p;
     EXPECT_GE(both.foundShare, 0.9) << "projector " << p;
     expectWithin(measure(f, *d->demux, p, 1, "sphere 90deg"), {1.0, 1.0, 0.985, 0.99, 0.99, 0.15},

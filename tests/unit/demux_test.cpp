@@ -128,6 +128,84 @@ TEST(Demux, FixedTileDirectionsReplaceTheEstimate) {
   }
 }
 
+// The angle from a to b in degrees, of axes (mod 180°), in [-90, 90).
+double axisDiffDeg(std::uint16_t a, std::uint16_t b) {
+  const double d = std::fmod((b - a) * 360.0 / 65536.0 + 450.0, 180.0) - 90.0;
+  return d;
+}
+
+// Given one clean pattern at 0° and a prediction that errs by a ramp, 0° over the right half up to
+// 60° at the left edge (as a surface turned far from the nominal one errs), when a frame runs,
+// then the lobe is found in every tile, also where it lies beyond the 30° tolerance of the
+// prediction: the found tiles grow into them. (One pattern: the crossings of two clean ones make
+// diagonal lobes of their own, which a prediction 45° off would match first.)
+TEST(Demux, FoundDirectionsGrowBeyondTheToleranceOfThePrediction) {
+  const std::vector<SyntheticPattern> patterns{{0.0, 5.0}};
+  constexpr int kW = 160;
+  constexpr int kH = 64;
+  const auto image = superpose(patterns, kW, kH);
+  const DemuxLayout layout{kW, kH, 1, {}};
+  auto predicted = exactPrediction(layout, patterns);
+  const int tilesX = layout.tilesX();
+  for (std::size_t t = 0; t < layout.tileCount(); ++t) {
+    const int tx = static_cast<int>(t) % tilesX;
+    const double errDeg = tx < tilesX / 2 ? 60.0 * (tilesX / 2 - tx) / (tilesX / 2) : 0.0;
+    predicted[t] = BinAngle::fromDegrees(errDeg).raw;
+  }
+  std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
+  Arena arena(memory);
+  auto demux = Demultiplexer::create(layout, predicted, arena);
+  ASSERT_TRUE(demux.has_value());
+  ASSERT_TRUE(demux->run(*ConstRgbView::packed(image, kW, kH)).has_value());
+  const std::uint16_t truth = BinAngle::fromDegrees(0.0).raw;
+  for (std::size_t t = 0; t < layout.tileCount(); ++t) {
+    if (static_cast<int>(t) % tilesX == 0) {
+      continue;  // the edge column's median of offsets sees only the ramp's steeper side
+    }
+    const TileDirection d = demux->tileDirections(0)[t];
+    EXPECT_EQ(d.present, 1) << "tile " << t;
+    EXPECT_LT(std::abs(axisDiffDeg(d.angle, truth)), 2.0) << "tile " << t;
+  }
+}
+
+// Given projector 0's stripes at 0° left of x = 78 and at 28° right of it (two surfaces meeting
+// at an edge, both within the tolerance of the prediction, 0°), projector 1's at 90°, when a
+// frame runs, then the first tile column right of the edge takes the 28° lobe that the tile
+// itself holds, though the 0° lobe, a third of its window, is the nearer the prediction.
+TEST(Demux, ATileTakesTheLobeOfItsOwnSurfaceAtAnEdge) {
+  constexpr int kW = 160;
+  constexpr int kH = 64;
+  constexpr int kEdge = 78;  // the first tile right of it has no sample whose support crosses it
+  const auto left = superpose({{0.0, 5.0}, {90.0, 5.0}}, kW, kH);
+  const auto right = superpose({{28.0, 5.0}, {90.0, 5.0}}, kW, kH);
+  std::vector<Rgb8> image = left;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = kEdge; x < kW; ++x) {
+      const auto i = static_cast<std::size_t>(y) * kW + static_cast<std::size_t>(x);
+      image[i] = right[i];
+    }
+  }
+  const DemuxLayout layout{kW, kH, 2, {}};
+  std::vector<std::byte> memory(*Demultiplexer::workspaceBytes(layout));
+  Arena arena(memory);
+  auto demux =
+      Demultiplexer::create(layout, exactPrediction(layout, {{0.0, 5.0}, {90.0, 5.0}}), arena);
+  ASSERT_TRUE(demux.has_value());
+  ASSERT_TRUE(demux->run(*ConstRgbView::packed(image, kW, kH)).has_value());
+  const int tilesX = layout.tilesX();
+  const int edgeTile = kEdge / layout.params.tilePx + 1;
+  for (int ty = 1; ty + 1 < layout.tilesY(); ++ty) {
+    const auto t = static_cast<std::size_t>(ty * tilesX + edgeTile);
+    const TileDirection d = demux->tileDirections(0)[t];
+    EXPECT_EQ(d.present, 1) << "tile row " << ty;
+    EXPECT_LT(std::abs(axisDiffDeg(d.angle, BinAngle::fromDegrees(28.0).raw)), 3.0)
+        << "tile row " << ty;
+    const TileDirection before = demux->tileDirections(0)[t - 1];
+    EXPECT_LT(std::abs(axisDiffDeg(before.angle, BinAngle::fromDegrees(0.0).raw)), 3.0)
+        << "tile row " << ty;
+  }
+}
+
 // Given two clean patterns 90° apart (and, separately, 70° apart), when a frame runs, then each
 // projector's boundaries lie where its stripe coordinate crosses an integer, with the class of
 // the colours on either side, and the frame touched the heap not once.

@@ -12,9 +12,11 @@
 //   windows stepped by π/4 that are not at a window edge; each is refined by two mean-shift
 //   steps on the histogram (exact weighted mean of the samples in the bins within ±2 of the
 //   centre) and matched to the nearest predicted axis (within the tolerance and half the angle to
-//   the nearest other axis, holding the minimum share); the doubled angle is halved and its sign
-//   taken from the prediction. Then a 3×3 median (twice) of the offsets from the prediction, and
-//   tiles without the lobe take their neighbours' offset.
+//   the nearest other axis, holding the minimum share), or to another lobe within the tolerance
+//   that the tile's own histogram holds three times more of; the doubled angle is halved and its
+//   sign taken from the prediction. Found tiles then grow into absent ones (the lobe nearest
+//   their found neighbours' direction), a 3×3 median (twice) of the offsets from the prediction
+//   follows, and tiles still without the lobe take their neighbours' offset.
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -30,9 +32,16 @@ constexpr int kMaxLobes = 8;
 constexpr int kShareBins = 3;  // a lobe's mass: ±3 bins (±17° doubled, ±8.4° of orientation)
 
 struct Lobe {
-  std::uint16_t angle2 = 0;  // refined doubled angle
-  bool used = false;         // matched, or holding too small a share to match
+  std::uint16_t angle2 = 0;    // refined doubled angle
+  bool used = false;           // matched, or holding too small a share to match
+  std::uint32_t tileMass = 0;  // the centre tile's own histogram within ±kShareBins
 };
+
+// A window that straddles two surfaces (an occlusion edge, a sharp bend) holds a lobe of each for
+// the same projector; the one nearest the prediction is often the other surface's (the flat
+// background's, say). A lobe the centre tile itself holds kTileMassFactor times more of is the
+// tile's own surface: decisive enough that the tile's few samples do not flip it by noise.
+constexpr std::uint64_t kTileMassFactor = 3;
 
 // Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
 // the bins within ±kRefineBins of the current centre, exact from each bin's weight and first
@@ -57,6 +66,26 @@ Lobe refine(int peakBin, const std::uint32_t (&weights)[kBins],
   }
   lobe.angle2 = static_cast<std::uint16_t>(static_cast<std::uint32_t>(centre) & 0xFFFFU);
   return lobe;
+}
+
+// The lobe a projector takes: `nearest` (the free lobe nearest its predicted doubled axis pred2),
+// unless another free lobe within its tolerance holds kTileMassFactor times more of the centre
+// tile's own weight.
+int preferTileLobe(const Lobe (&lobes)[kMaxLobes], int lobeCount, int nearest, std::uint16_t pred2,
+                   std::int32_t tolerance) {
+  int best = nearest;
+  for (int l = 0; l < lobeCount; ++l) {
+    if (lobes[l].used || l == nearest) {
+      continue;
+    }
+    std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
+    diff = diff < 0 ? -diff : diff;
+    if (diff <= tolerance &&
+        std::uint64_t{lobes[l].tileMass} > kTileMassFactor * std::uint64_t{lobes[best].tileMass}) {
+      best = l;
+    }
+  }
+  return best;
 }
 
 // Sums of tile histograms over a set of tiles: first moments in 64 bits; weights in 32 (a tile's
@@ -84,6 +113,65 @@ struct BinSums {
     }
   }
 };
+
+// The window histogram's lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by
+// π/4), each the first maximum of its two halves' first maxima, refined; `own` is the centre
+// tile's histogram. Returns how many.
+int findLobes(const BinSums& window, const std::uint32_t* own, std::uint64_t minSharePct,
+              Lobe (&lobes)[kMaxLobes]) {
+  const auto& hist = window.weights;
+  const auto& moment = window.moments;
+  std::uint64_t total = 0;
+  for (const std::uint64_t weight : hist) {
+    total += weight;
+  }
+  int lobeCount = 0;
+  int peakBins[kMaxLobes];
+  if (total == 0) {
+    return 0;
+  }
+  constexpr int kHalf = kBins / 8;
+  int halfBest[8];
+  for (int b = 0; b < 8; ++b) {
+    int best = b * kHalf;
+    for (int k = best + 1; k < (b + 1) * kHalf; ++k) {
+      best = hist[k] > hist[best] ? k : best;
+    }
+    halfBest[b] = best;
+  }
+  for (int aw = 0; aw < 8; ++aw) {
+    const int start = aw * kHalf;
+    const int upper = halfBest[(aw + 1) % 8];
+    const int best =
+        hist[upper] > hist[halfBest[aw]] ? start + kHalf + upper % kHalf : halfBest[aw];
+    if (best == start || best == start + kBins / 4 - 1 || hist[best % kBins] == 0) {
+      continue;
+    }
+    const int bin = best % kBins;
+    bool seen = false;
+    for (int l = 0; l < lobeCount; ++l) {
+      seen = seen || peakBins[l] == bin;
+    }
+    if (seen) {
+      continue;
+    }
+    peakBins[lobeCount] = bin;
+    lobes[lobeCount] = refine(bin, hist, moment);
+    // The lobe's mass: the window histogram within ±kShareBins of the refined peak.
+    const int centre = ((lobes[lobeCount].angle2 + kBinRaw / 2) / kBinRaw) % kBins;
+    std::uint64_t mass = 0;
+    for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
+      mass += hist[(k + kBins) % kBins];
+    }
+    // A lobe below the minimum share of the window's weight never matches.
+    lobes[lobeCount].used = mass * 100 < minSharePct * total;
+    for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
+      lobes[lobeCount].tileMass += own[(k + kBins) % kBins];
+    }
+    ++lobeCount;
+  }
+  return lobeCount;
+}
 
 constexpr int kMaxWindowTiles = 9;  // DemuxParams::windowTiles, as create() validates it
 
@@ -192,7 +280,7 @@ struct ProjectorTiles {
       const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX);
       for (int i = i0; i <= i1; ++i) {
         const std::size_t n = row + static_cast<std::size_t>(i);
-        if (tiles[n].present != 0) {
+        if (tiles[n].present == 1) {
           visit(wrapDiff(tiles[n].angle, prediction(n)));
         }
       }
@@ -215,6 +303,110 @@ void forEachTile(const ProjectorTiles& tiles, Fix fix) {
       fix(static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles.tilesX) +
               static_cast<std::size_t>(tx),
           tx, ty);
+    }
+  }
+}
+
+// Where a projector's lobe lies beyond the tolerance of the flat-surface prediction (a surface
+// turned far from the nominal one, as towards a sphere's rim), the found neighbours' direction is
+// the better centre: the found tiles grow into absent ones, one ring per pass, each absent tile
+// taking its window lobe nearest the mean offset of its found 3×3 neighbours, if within
+// kGrowTolerance2 and not nearer another projector's direction in the tile. A ring is marked
+// kGrowing until its pass ends, so that it grows from found tiles only.
+constexpr int kGrowPasses = 6;
+constexpr std::int32_t kGrowTolerance2 = 2 * 20 * 65536 / 360;  // 20° of orientation, doubled
+constexpr std::uint8_t kGrowing = 2;
+
+// The window histogram of one tile, summed directly.
+void windowOf(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+              std::span<const std::int32_t> tileMoments, int tx, int ty, BinSums& window) {
+  const int r = layout.params.windowTiles / 2;
+  const int tilesX = layout.tilesX();
+  const int tilesY = layout.tilesY();
+  window.clear();
+  for (int j = ty - r > 0 ? ty - r : 0; j <= ty + r && j < tilesY; ++j) {
+    for (int i = tx - r > 0 ? tx - r : 0; i <= tx + r && i < tilesX; ++i) {
+      const std::size_t at = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
+                              static_cast<std::size_t>(i)) *
+                             kBins;
+      for (int k = 0; k < kBins; ++k) {
+        window.weights[k] += tileHistograms[at + static_cast<std::size_t>(k)];
+        window.moments[k] += tileMoments[at + static_cast<std::size_t>(k)];
+      }
+    }
+  }
+}
+
+void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                    std::span<const std::int32_t> tileMoments,
+                    std::span<const std::uint16_t> predicted, std::span<TileDirection> out) {
+  const auto minSharePct = static_cast<std::uint64_t>(layout.params.minLobeSharePct);
+  const auto projectors = static_cast<std::size_t>(layout.projectors);
+  const std::size_t tileCount = layout.tileCount();
+  BinSums window;
+  for (int pass = 0; pass < kGrowPasses; ++pass) {
+    bool grew = false;
+    for (std::size_t p = 0; p < projectors; ++p) {
+      const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
+      forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
+        if (tiles.tiles[t].present != 0) {
+          return;
+        }
+        std::int32_t sum = 0;
+        std::int32_t count = 0;
+        tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) {
+          sum += value;
+          ++count;
+        });
+        if (count == 0) {
+          return;
+        }
+        const auto guess = static_cast<std::uint16_t>(tiles.prediction(t) +
+                                                      static_cast<std::uint16_t>(sum / count));
+        windowOf(layout, tileHistograms, tileMoments, tx, ty, window);
+        Lobe lobes[kMaxLobes];
+        const int lobeCount =
+            findLobes(window, tileHistograms.data() + t * kBins, minSharePct, lobes);
+        const auto guess2 = static_cast<std::uint16_t>(guess << 1U);
+        int best = -1;
+        std::int32_t bestDiff = kGrowTolerance2 + 1;
+        for (int l = 0; l < lobeCount; ++l) {
+          std::int32_t diff = wrapDiff(lobes[l].angle2, guess2);
+          diff = diff < 0 ? -diff : diff;
+          bool nearerOther = false;
+          for (std::size_t q = 0; q < projectors; ++q) {
+            const TileDirection& other = out[q * tileCount + t];
+            if (q == p || other.present == 0) {
+              continue;
+            }
+            std::int32_t otherDiff =
+                wrapDiff(lobes[l].angle2, static_cast<std::uint16_t>(other.angle << 1U));
+            otherDiff = otherDiff < 0 ? -otherDiff : otherDiff;
+            nearerOther = nearerOther || otherDiff <= diff;
+          }
+          if (!lobes[l].used && !nearerOther && diff < bestDiff) {
+            bestDiff = diff;
+            best = l;
+          }
+        }
+        if (best < 0) {
+          return;
+        }
+        auto angle = static_cast<std::uint16_t>(lobes[best].angle2 >> 1U);
+        const std::int32_t off = wrapDiff(angle, guess);
+        if (off > 16384 || off < -16384) {
+          angle = static_cast<std::uint16_t>(angle + 32768U);
+        }
+        tiles.tiles[t].angle = angle;
+        tiles.tiles[t].present = kGrowing;
+        grew = true;
+      });
+      for (TileDirection& d : tiles.tiles) {
+        d.present = d.present == kGrowing ? 1 : d.present;
+      }
+    }
+    if (!grew) {
+      break;
     }
   }
 }
@@ -417,56 +609,9 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       } else {
         windows.step(tx);
       }
-      const auto& hist = windows.sums().weights;
-      const auto& moment = windows.sums().moments;
-      std::uint64_t total = 0;
-      for (const std::uint64_t weight : hist) {
-        total += weight;
-      }
-      // Lobes: interior maxima of the 8 angle windows (π/2 wide, stepped by π/4), each the
-      // first maximum of its two halves' first maxima.
       Lobe lobes[kMaxLobes];
-      int lobeCount = 0;
-      int peakBins[kMaxLobes];
-      if (total > 0) {
-        constexpr int kHalf = kBins / 8;
-        int halfBest[8];
-        for (int b = 0; b < 8; ++b) {
-          int best = b * kHalf;
-          for (int k = best + 1; k < (b + 1) * kHalf; ++k) {
-            best = hist[k] > hist[best] ? k : best;
-          }
-          halfBest[b] = best;
-        }
-        for (int aw = 0; aw < 8; ++aw) {
-          const int start = aw * kHalf;
-          const int upper = halfBest[(aw + 1) % 8];
-          const int best =
-              hist[upper] > hist[halfBest[aw]] ? start + kHalf + upper % kHalf : halfBest[aw];
-          if (best == start || best == start + kBins / 4 - 1 || hist[best % kBins] == 0) {
-            continue;
-          }
-          const int bin = best % kBins;
-          bool seen = false;
-          for (int l = 0; l < lobeCount; ++l) {
-            seen = seen || peakBins[l] == bin;
-          }
-          if (seen) {
-            continue;
-          }
-          peakBins[lobeCount] = bin;
-          lobes[lobeCount] = refine(bin, hist, moment);
-          // The lobe's mass: the window histogram within ±kShareBins of the refined peak.
-          const int centre = ((lobes[lobeCount].angle2 + kBinRaw / 2) / kBinRaw) % kBins;
-          std::uint64_t mass = 0;
-          for (int k = centre - kShareBins; k <= centre + kShareBins; ++k) {
-            mass += hist[(k + kBins) % kBins];
-          }
-          // A lobe below the minimum share of the window's weight never matches.
-          lobes[lobeCount].used = mass * 100 < minSharePct * total;
-          ++lobeCount;
-        }
-      }
+      const int lobeCount =
+          findLobes(windows.sums(), tileHistograms.data() + tile * kBins, minSharePct, lobes);
 
       // Greedy matching: repeatedly the closest (projector, lobe) pair within tolerance.
       bool assigned[kMaxProjectors] = {false, false, false};
@@ -523,6 +668,12 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
         if (bestP < 0) {
           break;
         }
+        bestL = preferTileLobe(
+            lobes, lobeCount, bestL,
+            static_cast<std::uint16_t>(predicted[tile * static_cast<std::size_t>(projectors) +
+                                                 static_cast<std::size_t>(bestP)]
+                                       << 1U),
+            tolerance[bestP]);
         assigned[bestP] = true;
         lobes[bestL].used = true;
         TileDirection& d = out[static_cast<std::size_t>(bestP) * tileCount + tile];
@@ -537,6 +688,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       }
     }
   }
+  growFoundTiles(layout, tileHistograms, tileMoments, predicted, out);
   // Twice: the second pass removes what clusters of stray tiles leave after the first.
   medianFilterTiles(layout, predicted, out, scratch);
   medianFilterTiles(layout, predicted, out, scratch);
