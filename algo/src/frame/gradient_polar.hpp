@@ -42,7 +42,7 @@ constexpr std::uint64_t nearestRoot(std::uint64_t v) {
 // T_0 = x / (1 + x²), T_n = T_(n−1) · 2n / (2n + 1) · x² / (1 + x²): every term at most half
 // the one before for x <= 1, so about 40 terms reach 0. Each term is truncated: < 2^-33 rad in all.
 constexpr std::uint64_t atanQ40(std::uint64_t p) {
-  constexpr std::uint64_t kQ2 = 256 * 256;
+  constexpr std::uint64_t kQ2 = std::uint64_t{256} * 256;
   const std::uint64_t den = kQ2 + p * p;
   std::uint64_t term = ((p * 256) << 40) / den;  // < 2^39
   std::uint64_t sum = 0;
