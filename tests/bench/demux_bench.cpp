@@ -22,9 +22,11 @@
 //   (docs/decode.md); <cfg>/p_decode, p_triangulate, p_merge
 //                      those stages alone, on the output of the pipeline's last run.
 // Counters: px/s (frame pixels per CPU second); x_sobel = this benchmark's CPU time per frame /
-// one Sobel's CPU time measured at start-up (the mean of kSobelCalls calls after kSobelWarmUp
-// untimed ones, on the same frame, before any benchmark runs; the <cfg>/sobel benchmark's own
-// x_sobel checks that figure); arena = the configuration's Demultiplexer::workspaceBytes(), or
+// one Sobel's CPU time measured around it (the mean of kLocalSobelCalls calls just before and as
+// many just after the benchmark's loop, on the same frame: this shared machine's speed drifts by
+// tens of per cent over minutes, so a reference taken once at start-up skews the ratios of the
+// benchmarks that run later; the <cfg>/sobel benchmark's own x_sobel checks the figure);
+// sobel_ms = that reference; arena = the configuration's Demultiplexer::workspaceBytes(), or
 // CameraPipeline::workspaceBytes() for the pipeline benchmarks.
 // CPU time is the thread's (CLOCK_THREAD_CPUTIME_ID, the clock of Google Benchmark's CPU
 // column): on a shared 2-core machine it is what the code costs, where wall time (the Time
@@ -66,6 +68,7 @@ using Clock = std::chrono::steady_clock;
 constexpr double kNominalDepthM = 0.9;
 constexpr int kSobelWarmUp = 20;
 constexpr int kSobelCalls = 200;
+constexpr int kLocalSobelCalls = 100;
 
 // CPU time of the calling thread, the clock of Google Benchmark's CPU column.
 double threadCpuSeconds() {
@@ -284,6 +287,16 @@ struct Config {
     return static_cast<double>(pixelsOf(layout.width, layout.height));
   }
   void sobel() { cv::Sobel(sobelSrc, sobelDst, CV_16S, 1, 0, 3); }
+  // Thread CPU seconds per Sobel call over `calls` calls.
+  double sobelCpuPerCall(int calls) {
+    const double cpu0 = threadCpuSeconds();
+    for (int i = 0; i < calls; ++i) {
+      sobel();
+      benchmark::DoNotOptimize(sobelDst.data);
+      benchmark::ClobberMemory();
+    }
+    return (threadCpuSeconds() - cpu0) / double{calls};
+  }
 };
 
 // rig with camera 0 at twice the resolution (same field of view); projectors unchanged.
@@ -375,13 +388,7 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int 
     c->sobel();
   }
   const auto wall0 = Clock::now();
-  const double cpu0 = threadCpuSeconds();
-  for (int i = 0; i < kSobelCalls; ++i) {
-    c->sobel();
-    benchmark::DoNotOptimize(c->sobelDst.data);
-    benchmark::ClobberMemory();
-  }
-  c->sobelSecondsPerCall = (threadCpuSeconds() - cpu0) / double{kSobelCalls};
+  c->sobelSecondsPerCall = c->sobelCpuPerCall(kSobelCalls);
   c->sobelWallSecondsPerCall =
       std::chrono::duration<double>(Clock::now() - wall0).count() / double{kSobelCalls};
   std::fprintf(stderr,
@@ -394,19 +401,21 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int 
 
 // Times body per iteration. x_sobel comes from the loop's own thread CPU time (a counter cannot
 // read Google Benchmark's timer), which matches the CPU column to well under a per cent at
-// these durations.
+// these durations, over the Sobel reference taken around the loop.
 template <class Body>
-void timeFrames(benchmark::State& state, const Config& c, std::size_t arenaBytes,
-                const Body& body) {
+void timeFrames(benchmark::State& state, Config& c, std::size_t arenaBytes, const Body& body) {
+  const double sobelBefore = c.sobelCpuPerCall(kLocalSobelCalls);
   const double cpu0 = threadCpuSeconds();
   for (auto _ : state) {
     body();
     benchmark::ClobberMemory();
   }
   const double seconds = threadCpuSeconds() - cpu0;
+  const double sobelSeconds = (sobelBefore + c.sobelCpuPerCall(kLocalSobelCalls)) / 2;
   const auto frames = static_cast<double>(state.iterations());
   state.counters["px/s"] = benchmark::Counter(c.pixels() * frames, benchmark::Counter::kIsRate);
-  state.counters["x_sobel"] = frames > 0 ? seconds / frames / c.sobelSecondsPerCall : 0.0;
+  state.counters["x_sobel"] = frames > 0 ? seconds / frames / sobelSeconds : 0.0;
+  state.counters["sobel_ms"] = sobelSeconds * 1e3;
   state.counters["arena"] = benchmark::Counter(
       static_cast<double>(arenaBytes), benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
 }
