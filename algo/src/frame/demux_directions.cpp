@@ -271,9 +271,9 @@ struct ProjectorTiles {
   [[nodiscard]] std::uint16_t prediction(std::size_t tile) const {
     return predicted[tile * projectors + projector];
   }
-  // Calls visit(offset from the prediction) for each found tile within ±radius of (tx, ty).
+  // Calls visit(tile index) for each tile within ±radius of (tx, ty).
   template <class Visit>
-  void forEachFoundAround(int tx, int ty, int radius, Visit visit) const {
+  void forEachAround(int tx, int ty, int radius, Visit visit) const {
     const int i0 = tx - radius > 0 ? tx - radius : 0;
     const int i1 = tx + radius < tilesX ? tx + radius : tilesX - 1;
     const int j0 = ty - radius > 0 ? ty - radius : 0;
@@ -281,12 +281,18 @@ struct ProjectorTiles {
     for (int j = j0; j <= j1; ++j) {
       const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX);
       for (int i = i0; i <= i1; ++i) {
-        const std::size_t n = row + static_cast<std::size_t>(i);
-        if (tiles[n].present == 1) {
-          visit(wrapDiff(tiles[n].angle, prediction(n)));
-        }
+        visit(row + static_cast<std::size_t>(i));
       }
     }
+  }
+  // Calls visit(offset from the prediction) for each found tile within ±radius of (tx, ty).
+  template <class Visit>
+  void forEachFoundAround(int tx, int ty, int radius, Visit visit) const {
+    forEachAround(tx, ty, radius, [&](std::size_t n) {
+      if (tiles[n].present == 1) {
+        visit(wrapDiff(tiles[n].angle, prediction(n)));
+      }
+    });
   }
 };
 
@@ -314,10 +320,12 @@ void forEachTile(const ProjectorTiles& tiles, Fix fix) {
 // the better centre: the found tiles grow into absent ones, one ring per pass, each absent tile
 // taking its window lobe nearest the mean offset of its found 3×3 neighbours, if within
 // kGrowTolerance2 and not nearer another projector's direction in the tile. A ring is marked
-// kGrowing until its pass ends, so that it grows from found tiles only.
+// kGrowing during its pass, so that it grows from found tiles only, and kGrown during the next,
+// which retries only the absent tiles next to it (the others' neighbourhoods did not change).
 constexpr int kGrowPasses = 6;
 constexpr std::int32_t kGrowTolerance2 = 2 * 20 * 65536 / 360;  // 20° of orientation, doubled
 constexpr std::uint8_t kGrowing = 2;
+constexpr std::uint8_t kGrown = 3;
 
 // The window histogram of one tile, summed directly.
 void windowOf(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
@@ -356,11 +364,16 @@ void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> ti
         }
         std::int32_t sum = 0;
         std::int32_t count = 0;
-        tiles.forEachFoundAround(tx, ty, 1, [&](std::int32_t value) {
-          sum += value;
-          ++count;
+        bool nextToNew = pass == 0;
+        tiles.forEachAround(tx, ty, 1, [&](std::size_t n) {
+          const std::uint8_t present = tiles.tiles[n].present;
+          if (present == 1 || present == kGrown) {
+            sum += wrapDiff(tiles.tiles[n].angle, tiles.prediction(n));
+            ++count;
+            nextToNew = nextToNew || present == kGrown;
+          }
         });
-        if (count == 0) {
+        if (count == 0 || !nextToNew) {
           return;
         }
         const auto guess = static_cast<std::uint16_t>(tiles.prediction(t) +
@@ -404,12 +417,15 @@ void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> ti
         grew = true;
       });
       for (TileDirection& d : tiles.tiles) {
-        d.present = d.present == kGrowing ? 1 : d.present;
+        d.present = d.present == kGrown ? 1 : (d.present == kGrowing ? kGrown : d.present);
       }
     }
     if (!grew) {
       break;
     }
+  }
+  for (TileDirection& d : out) {
+    d.present = d.present == kGrown ? 1 : d.present;
   }
 }
 
