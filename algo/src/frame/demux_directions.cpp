@@ -315,6 +315,20 @@ void forEachTile(const ProjectorTiles& tiles, Fix fix) {
   }
 }
 
+// Calls fix(tiles, tile index, tx, ty) for every tile of every projector whose lobe is absent.
+template <class Fix>
+void forEachAbsentTile(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+                       std::span<TileDirection> out, Fix fix) {
+  for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
+    const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
+    forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
+      if (tiles.tiles[t].present == 0) {
+        fix(tiles, t, tx, ty);
+      }
+    });
+  }
+}
+
 // Where a projector's lobe lies beyond the tolerance of the flat-surface prediction (a surface
 // turned far from the nominal one, as towards a sphere's rim), the found neighbours' direction is
 // the better centre: the found tiles grow into absent ones, one ring per pass, each absent tile
@@ -356,69 +370,64 @@ void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> ti
   BinSums window;
   for (int pass = 0; pass < kGrowPasses; ++pass) {
     bool grew = false;
-    for (std::size_t p = 0; p < projectors; ++p) {
-      const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
-      forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
-        if (tiles.tiles[t].present != 0) {
-          return;
-        }
-        std::int32_t sum = 0;
-        std::int32_t count = 0;
-        bool nextToNew = pass == 0;
-        tiles.forEachAround(tx, ty, 1, [&](std::size_t n) {
-          const std::uint8_t present = tiles.tiles[n].present;
-          if (present == 1 || present == kGrown) {
-            sum += wrapDiff(tiles.tiles[n].angle, tiles.prediction(n));
-            ++count;
-            nextToNew = nextToNew || present == kGrown;
-          }
-        });
-        if (count == 0 || !nextToNew) {
-          return;
-        }
-        const auto guess = static_cast<std::uint16_t>(tiles.prediction(t) +
-                                                      static_cast<std::uint16_t>(sum / count));
-        windowOf(layout, tileHistograms, tileMoments, tx, ty, window);
-        Lobe lobes[kMaxLobes];
-        const int lobeCount =
-            findLobes(window, tileHistograms.data() + t * kBins, minSharePct, lobes);
-        const auto guess2 = static_cast<std::uint16_t>(guess << 1U);
-        int best = -1;
-        std::int32_t bestDiff = kGrowTolerance2 + 1;
-        for (int l = 0; l < lobeCount; ++l) {
-          std::int32_t diff = wrapDiff(lobes[l].angle2, guess2);
-          diff = diff < 0 ? -diff : diff;
-          bool nearerOther = false;
-          for (std::size_t q = 0; q < projectors; ++q) {
-            const TileDirection& other = out[q * tileCount + t];
-            if (q == p || other.present == 0) {
-              continue;
+    forEachAbsentTile(
+        layout, predicted, out, [&](const ProjectorTiles& tiles, std::size_t t, int tx, int ty) {
+          std::int32_t sum = 0;
+          std::int32_t count = 0;
+          bool nextToNew = pass == 0;
+          tiles.forEachAround(tx, ty, 1, [&](std::size_t n) {
+            const std::uint8_t present = tiles.tiles[n].present;
+            if (present == 1 || present == kGrown) {
+              sum += wrapDiff(tiles.tiles[n].angle, tiles.prediction(n));
+              ++count;
+              nextToNew = nextToNew || present == kGrown;
             }
-            std::int32_t otherDiff =
-                wrapDiff(lobes[l].angle2, static_cast<std::uint16_t>(other.angle << 1U));
-            otherDiff = otherDiff < 0 ? -otherDiff : otherDiff;
-            nearerOther = nearerOther || otherDiff <= diff;
+          });
+          if (count == 0 || !nextToNew) {
+            return;
           }
-          if (!lobes[l].used && !nearerOther && diff < bestDiff) {
-            bestDiff = diff;
-            best = l;
+          const auto guess = static_cast<std::uint16_t>(tiles.prediction(t) +
+                                                        static_cast<std::uint16_t>(sum / count));
+          windowOf(layout, tileHistograms, tileMoments, tx, ty, window);
+          Lobe lobes[kMaxLobes];
+          const int lobeCount =
+              findLobes(window, tileHistograms.data() + t * kBins, minSharePct, lobes);
+          const auto guess2 = static_cast<std::uint16_t>(guess << 1U);
+          int best = -1;
+          std::int32_t bestDiff = kGrowTolerance2 + 1;
+          for (int l = 0; l < lobeCount; ++l) {
+            std::int32_t diff = wrapDiff(lobes[l].angle2, guess2);
+            diff = diff < 0 ? -diff : diff;
+            bool nearerOther = false;
+            for (std::size_t q = 0; q < projectors; ++q) {
+              const TileDirection& other = out[q * tileCount + t];
+              if (q == tiles.projector || other.present == 0) {
+                continue;
+              }
+              std::int32_t otherDiff =
+                  wrapDiff(lobes[l].angle2, static_cast<std::uint16_t>(other.angle << 1U));
+              otherDiff = otherDiff < 0 ? -otherDiff : otherDiff;
+              nearerOther = nearerOther || otherDiff <= diff;
+            }
+            if (!lobes[l].used && !nearerOther && diff < bestDiff) {
+              bestDiff = diff;
+              best = l;
+            }
           }
-        }
-        if (best < 0) {
-          return;
-        }
-        auto angle = static_cast<std::uint16_t>(lobes[best].angle2 >> 1U);
-        const std::int32_t off = wrapDiff(angle, guess);
-        if (off > 16384 || off < -16384) {
-          angle = static_cast<std::uint16_t>(angle + 32768U);
-        }
-        tiles.tiles[t].angle = angle;
-        tiles.tiles[t].present = kGrowing;
-        grew = true;
-      });
-      for (TileDirection& d : tiles.tiles) {
-        d.present = d.present == kGrown ? 1 : (d.present == kGrowing ? kGrown : d.present);
-      }
+          if (best < 0) {
+            return;
+          }
+          auto angle = static_cast<std::uint16_t>(lobes[best].angle2 >> 1U);
+          const std::int32_t off = wrapDiff(angle, guess);
+          if (off > 16384 || off < -16384) {
+            angle = static_cast<std::uint16_t>(angle + 32768U);
+          }
+          tiles.tiles[t].angle = angle;
+          tiles.tiles[t].present = kGrowing;
+          grew = true;
+        });
+    for (TileDirection& d : out) {
+      d.present = d.present == kGrown ? 1 : (d.present == kGrowing ? kGrown : d.present);
     }
     if (!grew) {
       break;
@@ -482,24 +491,19 @@ void medianFilterTiles(const DemuxLayout& layout, std::span<const std::uint16_t>
 
 void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
                      std::span<TileDirection> out) {
-  for (std::size_t p = 0; p < static_cast<std::size_t>(layout.projectors); ++p) {
-    const ProjectorTiles tiles = projectorTiles(layout, predicted, out, p);
-    forEachTile(tiles, [&](std::size_t t, int tx, int ty) {
-      if (tiles.tiles[t].present != 0) {
-        return;
-      }
-      std::int32_t sum = 0;
-      std::int32_t count = 0;
-      tiles.forEachFoundAround(tx, ty, kFillRadius, [&](std::int32_t value) {
-        sum += value;
-        ++count;
-      });
-      if (count > 0) {
-        tiles.tiles[t].angle = static_cast<std::uint16_t>(tiles.prediction(t) +
-                                                          static_cast<std::uint16_t>(sum / count));
-      }
-    });
-  }
+  forEachAbsentTile(layout, predicted, out,
+                    [](const ProjectorTiles& tiles, std::size_t t, int tx, int ty) {
+                      std::int32_t sum = 0;
+                      std::int32_t count = 0;
+                      tiles.forEachFoundAround(tx, ty, kFillRadius, [&](std::int32_t value) {
+                        sum += value;
+                        ++count;
+                      });
+                      if (count > 0) {
+                        tiles.tiles[t].angle = static_cast<std::uint16_t>(
+                            tiles.prediction(t) + static_cast<std::uint16_t>(sum / count));
+                      }
+                    });
 }
 
 // histogramTiles()' working rows: the vertical prefilter and first derivative of a sample row,
