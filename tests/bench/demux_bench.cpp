@@ -295,7 +295,7 @@ struct Config {
       benchmark::DoNotOptimize(sobelDst.data);
       benchmark::ClobberMemory();
     }
-    return (threadCpuSeconds() - cpu0) / double{calls};
+    return (threadCpuSeconds() - cpu0) / static_cast<double>(calls);
   }
 };
 
