@@ -130,8 +130,7 @@ TEST(Demux, FixedTileDirectionsReplaceTheEstimate) {
 
 // The angle from a to b in degrees, of axes (mod 180°), in [-90, 90).
 double axisDiffDeg(std::uint16_t a, std::uint16_t b) {
-  const double d = std::fmod((b - a) * 360.0 / 65536.0 + 450.0, 180.0) - 90.0;
-  return d;
+  return std::fmod((b - a) * 360.0 / 65536.0 + 450.0, 180.0) - 90.0;
 }
 
 // Given one clean pattern at 0° and a prediction that errs by a ramp, 0° over the right half up to

@@ -45,6 +45,23 @@ struct Lobe {
 // tile's own surface: decisive enough that the tile's few samples do not flip it by noise.
 constexpr std::uint64_t kTileMassFactor = 3;
 
+// |a − b| of two BinAngle raw values, wrapped: in [0, 2^15].
+std::int32_t wrapDistance(std::uint16_t a, std::uint16_t b) {
+  const std::int32_t d = wrapDiff(a, b);
+  return d < 0 ? -d : d;
+}
+
+// The direction of the axis of doubled angle angle2 that lies within a quarter turn of
+// `reference` (the doubled angle has lost the sign; the prediction or the neighbours give it).
+std::uint16_t axisTowards(std::uint16_t angle2, std::uint16_t reference) {
+  auto angle = static_cast<std::uint16_t>(angle2 >> 1U);
+  const std::int32_t off = wrapDiff(angle, reference);
+  if (off > 16384 || off < -16384) {
+    angle = static_cast<std::uint16_t>(angle + 32768U);
+  }
+  return angle;
+}
+
 // Two mean-shift steps on the window histogram: the weighted mean doubled angle of the samples in
 // the bins within ±kRefineBins of the current centre, exact from each bin's weight and first
 // moment (Σ w·(angle − bin centre)).
@@ -80,9 +97,7 @@ int preferTileLobe(const Lobe (&lobes)[kMaxLobes], int lobeCount, int nearest, s
     if (lobes[l].used || l == nearest) {
       continue;
     }
-    std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
-    diff = diff < 0 ? -diff : diff;
-    if (diff <= tolerance &&
+    if (wrapDistance(lobes[l].angle2, pred2) <= tolerance &&
         std::uint64_t{lobes[l].tileMass} > kTileMassFactor * std::uint64_t{lobes[best].tileMass}) {
       best = l;
     }
@@ -191,11 +206,11 @@ class WindowSums {
         tilesY_(tilesY),
         radius_(radius) {}
 
-  // The window of tile (0, ty).
-  void start(int ty) {
+  // The window of tile (tx, ty), summed afresh; step(tx + 1) may follow.
+  void moveTo(int tx, int ty) {
     ty_ = ty;
     window_.clear();
-    for (int i = 0; i <= radius_ && i < tilesX_; ++i) {
+    for (int i = tx - radius_ > 0 ? tx - radius_ : 0; i <= tx + radius_ && i < tilesX_; ++i) {
       BinSums& column = slot(i);
       sumColumn(i, column);
       window_.add(column);
@@ -341,33 +356,14 @@ constexpr std::int32_t kGrowTolerance2 = 2 * 20 * 65536 / 360;  // 20° of orien
 constexpr std::uint8_t kGrowing = 2;
 constexpr std::uint8_t kGrown = 3;
 
-// The window histogram of one tile, summed directly.
-void windowOf(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
-              std::span<const std::int32_t> tileMoments, int tx, int ty, BinSums& window) {
-  const int r = layout.params.windowTiles / 2;
-  const int tilesX = layout.tilesX();
-  const int tilesY = layout.tilesY();
-  window.clear();
-  for (int j = ty - r > 0 ? ty - r : 0; j <= ty + r && j < tilesY; ++j) {
-    for (int i = tx - r > 0 ? tx - r : 0; i <= tx + r && i < tilesX; ++i) {
-      const std::size_t at = (static_cast<std::size_t>(j) * static_cast<std::size_t>(tilesX) +
-                              static_cast<std::size_t>(i)) *
-                             kBins;
-      for (int k = 0; k < kBins; ++k) {
-        window.weights[k] += tileHistograms[at + static_cast<std::size_t>(k)];
-        window.moments[k] += tileMoments[at + static_cast<std::size_t>(k)];
-      }
-    }
-  }
-}
-
 void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
                     std::span<const std::int32_t> tileMoments,
                     std::span<const std::uint16_t> predicted, std::span<TileDirection> out) {
   const auto minSharePct = static_cast<std::uint64_t>(layout.params.minLobeSharePct);
   const auto projectors = static_cast<std::size_t>(layout.projectors);
   const std::size_t tileCount = layout.tileCount();
-  BinSums window;
+  WindowSums windows(tileHistograms, tileMoments, layout.tilesX(), layout.tilesY(),
+                     layout.params.windowTiles / 2);
   for (int pass = 0; pass < kGrowPasses; ++pass) {
     bool grew = false;
     forEachAbsentTile(
@@ -388,26 +384,24 @@ void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> ti
           }
           const auto guess = static_cast<std::uint16_t>(tiles.prediction(t) +
                                                         static_cast<std::uint16_t>(sum / count));
-          windowOf(layout, tileHistograms, tileMoments, tx, ty, window);
+          windows.moveTo(tx, ty);
           Lobe lobes[kMaxLobes];
           const int lobeCount =
-              findLobes(window, tileHistograms.data() + t * kBins, minSharePct, lobes);
+              findLobes(windows.sums(), tileHistograms.data() + t * kBins, minSharePct, lobes);
           const auto guess2 = static_cast<std::uint16_t>(guess << 1U);
           int best = -1;
           std::int32_t bestDiff = kGrowTolerance2 + 1;
           for (int l = 0; l < lobeCount; ++l) {
-            std::int32_t diff = wrapDiff(lobes[l].angle2, guess2);
-            diff = diff < 0 ? -diff : diff;
+            const std::int32_t diff = wrapDistance(lobes[l].angle2, guess2);
             bool nearerOther = false;
             for (std::size_t q = 0; q < projectors; ++q) {
               const TileDirection& other = out[q * tileCount + t];
               if (q == tiles.projector || other.present == 0) {
                 continue;
               }
-              std::int32_t otherDiff =
-                  wrapDiff(lobes[l].angle2, static_cast<std::uint16_t>(other.angle << 1U));
-              otherDiff = otherDiff < 0 ? -otherDiff : otherDiff;
-              nearerOther = nearerOther || otherDiff <= diff;
+              nearerOther = nearerOther ||
+                            wrapDistance(lobes[l].angle2,
+                                         static_cast<std::uint16_t>(other.angle << 1U)) <= diff;
             }
             if (!lobes[l].used && !nearerOther && diff < bestDiff) {
               bestDiff = diff;
@@ -417,12 +411,7 @@ void growFoundTiles(const DemuxLayout& layout, std::span<const std::uint32_t> ti
           if (best < 0) {
             return;
           }
-          auto angle = static_cast<std::uint16_t>(lobes[best].angle2 >> 1U);
-          const std::int32_t off = wrapDiff(angle, guess);
-          if (off > 16384 || off < -16384) {
-            angle = static_cast<std::uint16_t>(angle + 32768U);
-          }
-          tiles.tiles[t].angle = angle;
+          tiles.tiles[t].angle = axisTowards(lobes[best].angle2, guess);
           tiles.tiles[t].present = kGrowing;
           grew = true;
         });
@@ -639,7 +628,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       const std::size_t tile = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
                                static_cast<std::size_t>(tx);
       if (tx == 0) {
-        windows.start(ty);
+        windows.moveTo(0, ty);
       } else {
         windows.step(tx);
       }
@@ -655,23 +644,22 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
             predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
         d.present = 0;
       }
+      // Projector p's predicted axis in the tile, as a doubled angle.
+      const auto predicted2 = [&](int p) {
+        return static_cast<std::uint16_t>(
+            predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)]
+            << 1U);
+      };
       // Each projector's tolerance: the cap, and at most half the doubled-angle distance to the
       // nearest other predicted axis (tilted surfaces turn stripes far from the prediction; two
       // patterns 90° apart allow 45°, three 60° apart 30°).
       std::int32_t tolerance[kMaxProjectors] = {tolerance2, tolerance2, tolerance2};
       for (int p = 0; p < projectors; ++p) {
-        const auto pp = static_cast<std::uint16_t>(
-            predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)]
-            << 1U);
         for (int q = 0; q < projectors; ++q) {
           if (q == p) {
             continue;
           }
-          const auto qq = static_cast<std::uint16_t>(
-              predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(q)]
-              << 1U);
-          std::int32_t apart = wrapDiff(pp, qq);
-          apart = apart < 0 ? -apart : apart;
+          const std::int32_t apart = wrapDistance(predicted2(p), predicted2(q));
           tolerance[p] = apart / 2 < tolerance[p] ? apart / 2 : tolerance[p];
         }
       }
@@ -683,15 +671,11 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
           if (assigned[p]) {
             continue;
           }
-          const std::uint16_t pred =
-              predicted[tile * static_cast<std::size_t>(projectors) + static_cast<std::size_t>(p)];
-          const auto pred2 = static_cast<std::uint16_t>(pred << 1U);
           for (int l = 0; l < lobeCount; ++l) {
             if (lobes[l].used) {
               continue;
             }
-            std::int32_t diff = wrapDiff(lobes[l].angle2, pred2);
-            diff = diff < 0 ? -diff : diff;
+            const std::int32_t diff = wrapDistance(lobes[l].angle2, predicted2(p));
             if (diff <= tolerance[p] && diff < bestDiff) {
               bestDiff = diff;
               bestP = p;
@@ -702,22 +686,11 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
         if (bestP < 0) {
           break;
         }
-        bestL = preferTileLobe(
-            lobes, lobeCount, bestL,
-            static_cast<std::uint16_t>(predicted[tile * static_cast<std::size_t>(projectors) +
-                                                 static_cast<std::size_t>(bestP)]
-                                       << 1U),
-            tolerance[bestP]);
+        bestL = preferTileLobe(lobes, lobeCount, bestL, predicted2(bestP), tolerance[bestP]);
         assigned[bestP] = true;
         lobes[bestL].used = true;
         TileDirection& d = out[static_cast<std::size_t>(bestP) * tileCount + tile];
-        const std::uint16_t pred = d.angle;
-        auto angle = static_cast<std::uint16_t>(lobes[bestL].angle2 >> 1U);
-        const std::int32_t off = wrapDiff(angle, pred);
-        if (off > 16384 || off < -16384) {
-          angle = static_cast<std::uint16_t>(angle + 32768U);
-        }
-        d.angle = angle;
+        d.angle = axisTowards(lobes[bestL].angle2, d.angle);  // d.angle: the prediction
         d.present = 1;
       }
     }
