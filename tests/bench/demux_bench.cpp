@@ -148,9 +148,10 @@ class Stages {
         rows_(static_cast<std::size_t>(h_)),
         filterMemory_(kern::RowBlock<std::int32_t>::valuesFor(kern::kFilterRows, w_)),
         filterRows_(filterMemory_, w_),
-        workMemory_(kern::RowBlock<std::int16_t>::valuesFor(kern::kWorkRows, w_)),
+        workMemory_(kern::RowBlock<std::int16_t>::valuesFor(kern::kSharedWorkRows, w_)),
         workRows_(workMemory_, w_),
         strength_(pixelsOf(w_, h_)),
+        derivativeStrength_(pixelsOf(w_, h_)),
         minStrength_(kern::minStrengthQ11(layout.params)) {
     units_.fill();
     kern::tileInterpolation(w_, layout.params.tilePx, layout.tilesX(), columns_);
@@ -184,18 +185,19 @@ class Stages {
     kern::interpolateDirections(layout_, tileDirections_, columns_, rows_, directionPlanes());
   }
   void separate() {
-    kern::separate(smoothed_.views, layout_, tileDirections_, tileInverse_, columns_, rows_, units_,
-                   filterRows_, workRows_, directionPlanes(),
+    kern::separate(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_, filterRows_,
+                   workRows_, directionPlanes(),
                    std::span(separatedPlanes_).first(projectors_.size()),
                    std::span(orderPlanes_).first(projectors_.size()));
   }
   void boundaries() {
     for (ProjectorOut& out : projectors_) {
-      kern::detectBoundaries(out.separated.views,
-                             viewOf(std::span<const std::uint8_t>(out.order), w_, h_),
-                             viewOf(std::span<const std::uint16_t>(out.direction), w_, h_), units_,
-                             minStrength_, workRows_, viewOf(std::span(strength_), w_, h_),
-                             viewOf(std::span(out.boundaries), w_, h_));
+      kern::detectBoundaries(
+          out.separated.views, viewOf(std::span<const std::uint8_t>(out.order), w_, h_),
+          viewOf(std::span<const std::uint16_t>(out.direction), w_, h_), units_,
+          {tileInverse_, layout_.tilesX(), columns_, rows_}, minStrength_, workRows_,
+          {viewOf(std::span(strength_), w_, h_), viewOf(std::span(derivativeStrength_), w_, h_)},
+          viewOf(std::span(out.boundaries), w_, h_));
     }
   }
   void all(algo::ConstRgbView image) {
@@ -250,6 +252,7 @@ class Stages {
   std::vector<std::int16_t> workMemory_;
   kern::RowBlock<std::int16_t> workRows_;
   std::vector<std::uint16_t> strength_;
+  std::vector<std::uint16_t> derivativeStrength_;
   std::vector<ProjectorOut> projectors_;
   std::array<algo::DirectionPlane, algo::kMaxProjectors> directionPlanes_{};
   std::array<kern::Planes3, algo::kMaxProjectors> separatedPlanes_{};

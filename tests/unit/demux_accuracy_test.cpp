@@ -178,14 +178,15 @@ TEST(DemuxAccuracy, ThreePatterns60DegOnAPlane) {
 }
 
 // The RGBCMY panel (paper Fig. 13): strong surface colours, divided out by the local average.
-// Directions, recall, precision and class accuracy meet the targets (97 % class on the panel);
-// the position error at the colour edges does not yet (ratchet 0.18 px).
+// Every target holds (97 % class on the panel). The position is where the colour edges bite:
+// 0.17 px when it came from the relative strengths (each sample with its own tile's divisor,
+// a dark channel's noise scaled up).
 TEST(DemuxAccuracy, TwoPatternsOnTheRgbcmyPanel) {
   const auto f = render("rig_2proj_1cam.json", "rgbcmy_panel");
   const auto d = test::demultiplex(f);
   for (int p = 0; p < 2; ++p) {
     expectWithin(measure(f, *d->demux, p, 2, "rgbcmy panel 90deg"),
-                 {2.0, 5.0, 0.98, 0.98, 0.97, 0.18}, "projector " + std::to_string(p));
+                 {2.0, 5.0, 0.98, 0.98, 0.97, 0.15}, "projector " + std::to_string(p));
   }
 }
 

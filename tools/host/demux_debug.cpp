@@ -48,8 +48,8 @@ sim::RgbImage renderSeparated(const algo::ImageView<const std::int16_t> (&channe
   const int w = channels[0].width();
   const int h = channels[0].height();
   sim::RgbImage out = blankImage(w, h);
-  // Q4.11: ±1 (a step of the local average colour per pixel) spans ±127 grey levels.
-  constexpr double kGain = 127.0 / 2048.0;
+  // 32 × grey level per pixel: an edge of 50 grey levels per pixel shows as ±100.
+  constexpr double kGain = 1.0 / 16.0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       out.pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +

@@ -70,7 +70,7 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   step(carveSpan(carver, filterRows_,
                  demux::RowBlock<std::int32_t>::valuesFor(demux::kFilterRows, l.width)));
   step(carveSpan(carver, workRows_,
-                 demux::RowBlock<std::int16_t>::valuesFor(demux::kWorkRows, l.width)));
+                 demux::RowBlock<std::int16_t>::valuesFor(demux::kSharedWorkRows, l.width)));
   step(carveSpan(carver, tileHistograms_, tiles * demux::kBins));
   step(carveSpan(carver, tileMoments_, tiles * demux::kBins));
   step(carveSpan(carver, tileColourSums_, tiles * 3));
@@ -88,6 +88,7 @@ Result<void> Demultiplexer::carve(Carver& carver) {
     }
   }
   step(carveImage(carver, strength_, l.width, l.height));
+  step(carveImage(carver, derivativeStrength_, l.width, l.height));
   for (std::size_t p = 0; p < projectors; ++p) {
     step(carveImage(carver, order_[p], l.width, l.height));
     step(carveImage(carver, boundaries_[p], l.width, l.height));
@@ -155,18 +156,19 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::interpolateDirections(layout_, tileDirections_, columns_, rows_,
                                std::span<const DirectionPlane>(directions_.data(), projectors));
   // Every projector separated in one sweep (the derivatives are shared), then its boundaries.
-  demux::separate(smoothed_, layout_, tileDirections_, tileInverseColour_, columns_, rows_,
-                  units_[0], demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
+  demux::separate(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
+                  demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
                   demux::RowBlock<std::int16_t>(workRows_, layout_.width),
                   std::span<const DirectionPlane>(directions_.data(), projectors),
                   std::span<const demux::Planes3>(separated_.data(), projectors),
                   std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
   // separate() is done with its working rows: they hold detectBoundaries()' ring.
-  static_assert(demux::kBoundaryRingRows <= demux::kWorkRows);
+  const demux::TileColours colours{tileInverseColour_, layout_.tilesX(), columns_, rows_};
   for (std::size_t q = 0; q < projectors; ++q) {
-    demux::detectBoundaries(
-        separated_[q], order_[q], directions_[q], units_[0], demux::minStrengthQ11(p),
-        demux::RowBlock<std::int16_t>(workRows_, layout_.width), strength_, boundaries_[q]);
+    demux::detectBoundaries(separated_[q], order_[q], directions_[q], units_[0], colours,
+                            demux::minStrengthQ11(p),
+                            demux::RowBlock<std::int16_t>(workRows_, layout_.width),
+                            {strength_, derivativeStrength_}, boundaries_[q]);
   }
   return {};
 }

@@ -11,6 +11,15 @@
 #include "smx/algo/demux.hpp"
 #include "smx/algo/image_view.hpp"
 
+// GCC's hint that a loop carries no dependence through memory: the per-pixel loops over many
+// int16 rows have more pointers than its run-time alias checks take. Other compilers (the
+// lint's clang) do without.
+#if defined(__GNUC__) && !defined(__clang__)
+#define SMX_IVDEP _Pragma("GCC ivdep")
+#else
+#define SMX_IVDEP
+#endif
+
 namespace smx::algo::demux {
 
 inline constexpr int kBins = 64;               // doubled-angle histogram bins (2π)
@@ -117,7 +126,7 @@ void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> 
 // separate()'s rows: a ring of horizontally filtered rows (int32; 5 rows × 3 channels × 3
 // filters) and the current row's derivatives, unit vectors and tile data (int16).
 inline constexpr std::size_t kFilterRows = 45;
-inline constexpr std::size_t kWorkRows = 39;
+inline constexpr std::size_t kWorkRows = 33;
 
 // The signed difference a − b of two BinAngle raw values, wrapped into [−2^15, 2^15).
 [[nodiscard]] inline std::int32_t wrapDiff(std::uint16_t a, std::uint16_t b) {
@@ -130,31 +139,52 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
                            std::span<const DirectionPlane> out);
 
-// Stages 3–4 for every projector in one sweep: per projector, the separated, colour-normalised
-// derivative per channel (Q4.11) and the derivative order per pixel (1 or 2; 0 on the border).
+// Stage 3 for every projector in one sweep: per projector, the separated derivative per channel
+// (D, 32 × grey level per pixel for the first order) and the derivative order per pixel (1 or
+// 2; 0 on the border).
 // Output row y is written after row y + 2 of smoothed is read, and no row of smoothed is read
 // twice, so one projector's separated planes may take smoothed's memory.
 void separate(const Planes3& smoothed, const DemuxLayout& layout,
-              std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
-              std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const RowBlock<std::int32_t>& filtered,
-              const RowBlock<std::int16_t>& work, std::span<const DirectionPlane> directions,
-              std::span<const Planes3> separated, std::span<const ImageView<std::uint8_t>> order);
+              std::span<const TileDirection> tiles, std::span<const TileInterp> columns,
+              std::span<const TileInterp> rows, const UnitTable& units,
+              const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
+              std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
+              std::span<const ImageView<std::uint8_t>> order);
 
 // detectBoundaries()'s minStrength: the parameter's per mille of the local colour in Q4.11.
 [[nodiscard]] constexpr int minStrengthQ11(const DemuxParams& params) {
   return (params.minStrengthPermille << kRelativeShift) / 1000;
 }
 
-// Stage 5 for one projector: strength = max − min of the boundary response, then non-maximum
-// suppression along the encoding direction, sub-pixel offset and class. ringRows: a ring of
-// kBoundaryRingRows working rows of the image's width (run() lends separate()'s) keeping the
-// second-order samples of the last kBoundaryRingSlots strength rows for their maxima.
+// Stages 4–5 for one projector: the response relative to the local colour, its strength
+// max − min over the channels, then non-maximum suppression along the encoding direction,
+// sub-pixel offset and class. ringRows: a ring of kBoundaryRingRows working rows of the image's
+// width (run() lends separate()'s) keeping the second-order samples of the last
+// kBoundaryRingSlots strength rows for their maxima, and the divisor of two tile rows.
 inline constexpr std::size_t kBoundaryRingSlots = 4;
-inline constexpr std::size_t kBoundaryRingRows = kBoundaryRingSlots * 6;
+inline constexpr std::size_t kBoundaryRingRows = kBoundaryRingSlots * 6 + std::size_t{2} * 6;
+// The int16 working rows run() carves: separate()'s, then detectBoundaries()' ring.
+inline constexpr std::size_t kSharedWorkRows =
+    kWorkRows > kBoundaryRingRows ? kWorkRows : kBoundaryRingRows;
+// The divisor: per tile and channel 2^24 / average (inverseTileColours), each pixel taking its
+// nearest tile's (the columns' and rows' `nearest`).
+struct TileColours {
+  std::span<const std::uint32_t> inverse;
+  int tilesX;
+  std::span<const TileInterp> columns;
+  std::span<const TileInterp> rows;
+};
+// The strength planes (max − min over the channels), shared by the projectors: of the response
+// relative to the local colour, which finds the boundaries, and of the derivative itself, which
+// places them.
+struct StrengthPlanes {
+  ImageView<std::uint16_t> relative;
+  ImageView<std::uint16_t> derivative;
+};
 void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
-                      ConstDirectionPlane direction, const UnitTable& units, int minStrength,
-                      const RowBlock<std::int16_t>& ringRows, ImageView<std::uint16_t> strength,
+                      ConstDirectionPlane direction, const UnitTable& units,
+                      const TileColours& colours, int minStrength,
+                      const RowBlock<std::int16_t>& ringRows, const StrengthPlanes& strengths,
                       BoundaryPlane out);
 
 }  // namespace smx::algo::demux

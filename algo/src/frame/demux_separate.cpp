@@ -1,5 +1,5 @@
-// Stages 3–4: pattern separation by steered derivatives (paper eqs 6–10) and division by the
-// locally averaged colour (§4.3), every projector in one sweep over the rows.
+// Stage 3: pattern separation by steered derivatives (paper eqs 6–10), every projector in one
+// sweep over the rows. The division by the local colour (§4.3) is detectBoundaries()'.
 //   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
 //   to the pixel; unit vectors Q1.14 from the table. Presence: the nearest tile's.
 //   Derivatives of S by matched 5-tap separable filters (below), row-streamed: the horizontal
@@ -11,8 +11,8 @@
 //                axis (so the surviving term keeps its sign).
 //   Second order D_c = vᵀ H_c w; v, w the normals of the two other patterns' axes, signed
 //                likewise.
-//   Normalised value N_c = D_c · (2^24 / average_c) >> 13: Q4.11 relative to the average colour,
-//   saturated to int16.
+//   Where max_c D − min_c D is below the contrast floor, D is 0 (noise in shadows and on black,
+//   which the division by a dark average would lift over the relative threshold).
 //   Since 0 <= S <= 16 × 255, every derivative (|·| <= 16 575 after the 2^-13 below), unit
 //   vector, steering coefficient and D (|D| < 2^14) fits int16: the steering multiplies int16 by
 //   int16 into int32, which the vector units do natively. The steering runs per span of pixels
@@ -23,15 +23,6 @@
 
 #include "demux_kernels.hpp"
 #include "smx/algo/fixed.hpp"
-
-// GCC's hint that a loop carries no dependence through memory: with every row int16, the
-// steering loops have more pointers than its run-time alias checks take. Other compilers (the
-// lint's clang) do without.
-#if defined(__GNUC__) && !defined(__clang__)
-#define SMX_IVDEP _Pragma("GCC ivdep")
-#else
-#define SMX_IVDEP
-#endif
 
 namespace smx::algo::demux {
 
@@ -47,9 +38,9 @@ constexpr std::size_t filterRowIndex(int slot, int channel, int filter) {
 }
 
 // The int16 working rows: the current row's derivatives per channel, every projector's unit
-// vectors along it, the tile colour per channel and pixel, and per tile row and projector which
-// other patterns each tile column holds; then the tile runs (first pixel and tile of each) and
-// which derivative orders each tile column needs; then one projector's steering results.
+// vectors along it, and per tile row and projector which other patterns each tile column holds;
+// then the tile runs (first pixel and tile of each) and which derivative orders each tile column
+// needs; then one projector's steering results.
 enum DerivativeKind : int { kGx, kGy, kHxx, kHyy, kHxy, kDerivativeKinds };
 constexpr std::size_t derivativeRowIndex(std::size_t channel, DerivativeKind kind) {
   return channel * kDerivativeKinds + static_cast<std::size_t>(kind);
@@ -58,11 +49,7 @@ constexpr std::size_t kUnitRows = std::size_t{3} * kDerivativeKinds;
 constexpr std::size_t unitRowIndex(int projector, int component) {
   return kUnitRows + static_cast<std::size_t>(projector) * 2 + static_cast<std::size_t>(component);
 }
-constexpr std::size_t kColourRows = kUnitRows + std::size_t{2} * kMaxProjectors;
-constexpr std::size_t colourRowIndex(std::size_t channel, int part) {
-  return kColourRows + channel * 2 + static_cast<std::size_t>(part);
-}
-constexpr std::size_t kOthersRows = kColourRows + 6;
+constexpr std::size_t kOthersRows = kUnitRows + std::size_t{2} * kMaxProjectors;
 constexpr std::size_t othersRowIndex(int projector) {
   return kOthersRows + static_cast<std::size_t>(projector);
 }
@@ -170,10 +157,10 @@ namespace {
 
 // One row's steering inputs and outputs, x in [2, w − 3]. The per-pixel loops below are written
 // for GCC's vectoriser: straight-line int16/int32 arithmetic with selects instead of branches, no
-// table lookups (the unit vectors and the tile colour are spread into rows of their own
-// beforehand), and rows that never overlap (ivdep). GCC multiplies int16 by int16 into int32 in
-// int16 lanes only when both factors are loaded as int16, so the steering coefficients of the
-// second order and D go through rows of their own.
+// table lookups (the unit vectors are spread into rows of their own beforehand), and rows that
+// never overlap (ivdep). GCC multiplies int16 by int16 into int32 in int16 lanes only when both
+// factors are loaded as int16, so the steering coefficients of the second order and D go through
+// rows of their own.
 struct SteerRow {
   const std::int16_t* gx[3];
   const std::int16_t* gy[3];
@@ -288,32 +275,11 @@ void steerMixed(const SteerRow& r, UnitRows own, UnitRows first, UnitRows second
   }
 }
 
-// The tile's inverse colour 2^24 / average (<= 2^24 / kColourFloor = 2^17) per pixel as high
-// (>> 4) and low (& 15) parts, both int16.
-struct ColourRows {
-  const std::int16_t* high[3];
-  const std::int16_t* low[3];
-};
-
-// D · inverse >> kNormShift saturated to int16, as the exact product would give: with inverse =
-// 16·high + low, D · inverse >> 13 = (D · high + (D · low >> 4)) >> 9 (floor division nests), and
-// D · high < 2^14 · 2^13 fits int32.
-constexpr int kNormShift = kInverseShift - kRelativeShift;
-constexpr int kInverseSplit = 4;
-
-// Below the contrast floor (noise in shadows and on black) nothing is separated: the division
-// by a dark average would lift it over the relative threshold.
-void normaliseRow(const SteerRow& r, const ColourRows& colour, std::int32_t minContrast, int w,
-                  std::int16_t* const (&out)[3]) {
+// Below the contrast floor nothing is separated.
+void maskRow(const SteerRow& r, std::int32_t minContrast, int w, std::int16_t* const (&out)[3]) {
   const std::int16_t* d0 = r.d[0];
   const std::int16_t* d1 = r.d[1];
   const std::int16_t* d2 = r.d[2];
-  const auto scale = [](std::int16_t d, std::int16_t high, std::int16_t low) {
-    const std::int32_t scaled =
-        (d * high + ((d * low) >> kInverseSplit)) >> (kNormShift - kInverseSplit);
-    const std::int32_t upper = scaled > 32767 ? 32767 : scaled;
-    return static_cast<std::int16_t>(upper < -32768 ? -32768 : upper);
-  };
   SMX_IVDEP
   for (int x = 2; x + 2 < w; ++x) {
     const std::int16_t hi01 = d0[x] > d1[x] ? d0[x] : d1[x];
@@ -321,9 +287,9 @@ void normaliseRow(const SteerRow& r, const ColourRows& colour, std::int32_t minC
     const std::int16_t hi = hi01 > d2[x] ? hi01 : d2[x];
     const std::int16_t lo = lo01 < d2[x] ? lo01 : d2[x];
     const std::int16_t keep = hi - lo >= minContrast ? std::int16_t{-1} : std::int16_t{0};
-    out[0][x] = static_cast<std::int16_t>(scale(d0[x], colour.high[0][x], colour.low[0][x]) & keep);
-    out[1][x] = static_cast<std::int16_t>(scale(d1[x], colour.high[1][x], colour.low[1][x]) & keep);
-    out[2][x] = static_cast<std::int16_t>(scale(d2[x], colour.high[2][x], colour.low[2][x]) & keep);
+    out[0][x] = static_cast<std::int16_t>(d0[x] & keep);
+    out[1][x] = static_cast<std::int16_t>(d1[x] & keep);
+    out[2][x] = static_cast<std::int16_t>(d2[x] & keep);
   }
 }
 
@@ -402,24 +368,6 @@ void forSpansNeeding(const TileRuns& runs, const std::int16_t* needs, int order,
   }
 }
 
-void spreadTileColour(std::span<const std::uint32_t> inverseColour, const DemuxLayout& layout,
-                      int tileRow, const TileRuns& runs, const RowBlock<std::int16_t>& work) {
-  const std::uint32_t* inverse =
-      inverseColour.data() +
-      static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(layout.tilesX()) * 3;
-  for (std::size_t c = 0; c < 3; ++c) {
-    std::int16_t* high = work.row(colourRowIndex(c, 0));
-    std::int16_t* low = work.row(colourRowIndex(c, 1));
-    for (int k = 0; k < runs.runs; ++k) {
-      const std::uint32_t inv = inverse[static_cast<std::size_t>(runs.tiles[k]) * 3 + c];
-      std::fill(high + runs.starts[k], high + runs.starts[k + 1],
-                static_cast<std::int16_t>(inv >> kInverseSplit));
-      std::fill(low + runs.starts[k], low + runs.starts[k + 1],
-                static_cast<std::int16_t>(inv & ((1U << kInverseSplit) - 1)));
-    }
-  }
-}
-
 // One projector's interior row, per span of runs whose tiles hold the same other patterns:
 // there the derivative is fixed, so each span is one branch-free loop.
 void steerRow(const SteerRow& steer, const std::int16_t* others, const UnitRows (&unitRows)[3],
@@ -463,11 +411,11 @@ void clearRow(const Planes3& separated, ImageView<std::uint8_t> order, int y, in
 }  // namespace
 
 void separate(const Planes3& smoothed, const DemuxLayout& layout,
-              std::span<const TileDirection> tiles, std::span<const std::uint32_t> inverseColour,
-              std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-              const UnitTable& units, const RowBlock<std::int32_t>& filtered,
-              const RowBlock<std::int16_t>& work, std::span<const DirectionPlane> directions,
-              std::span<const Planes3> separated, std::span<const ImageView<std::uint8_t>> order) {
+              std::span<const TileDirection> tiles, std::span<const TileInterp> columns,
+              std::span<const TileInterp> rows, const UnitTable& units,
+              const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
+              std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
+              std::span<const ImageView<std::uint8_t>> order) {
   const int w = layout.width;
   const int h = layout.height;
   const int projectors = layout.projectors;
@@ -493,7 +441,6 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
 
   const TileRuns runs = findRuns(columns, w, work.row(kRunStartRow), work.row(kRunTileRow));
   SteerRow steer{};
-  ColourRows colour{};
   for (std::size_t c = 0; c < 3; ++c) {
     steer.gx[c] = work.row(derivativeRowIndex(c, kGx));
     steer.gy[c] = work.row(derivativeRowIndex(c, kGy));
@@ -501,8 +448,6 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
     steer.hyy[c] = work.row(derivativeRowIndex(c, kHyy));
     steer.hxy[c] = work.row(derivativeRowIndex(c, kHxy));
     steer.d[c] = work.row(kSteerRows + c);
-    colour.high[c] = work.row(colourRowIndex(c, 0));
-    colour.low[c] = work.row(colourRowIndex(c, 1));
   }
   steer.cxx = work.row(kSteerRows + 3);
   steer.cxy = work.row(kSteerRows + 4);
@@ -530,7 +475,6 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
     const int tileRow = rows[static_cast<std::size_t>(y)].nearest;
     if (tileRow != casesRow) {
       classifyTileRow(tiles, layout, tileRow, work);
-      spreadTileColour(inverseColour, layout, tileRow, runs, work);
       casesRow = tileRow;
     }
     // Vertical halves of the separable filters over rows y − 2 … y + 2, per channel; only the
@@ -567,7 +511,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
       steerRow(steer, work.row(othersRowIndex(p)), unitRows, p, runs,
                order[static_cast<std::size_t>(p)].rowPtr(y));
       std::int16_t* const out[3] = {planes[0].rowPtr(y), planes[1].rowPtr(y), planes[2].rowPtr(y)};
-      normaliseRow(steer, colour, minContrast, w, out);
+      maskRow(steer, minContrast, w, out);
     }
   }
 }

@@ -98,9 +98,9 @@ class Demultiplexer {
   // projector-major as tileDirections() reads them; copied, no allocation.
   [[nodiscard]] Result<void> fixTileDirections(std::span<const TileDirection> tiles);
 
-  // Debug view of the last run(): the projector's colour-normalised separated derivative per
-  // channel (Q4.11 of the local average colour). The last projector's planes share the smoothed
-  // image's memory, so they hold until the next run().
+  // Debug view of the last run(): the projector's separated derivative per channel, before the
+  // division by the local colour (32 × grey level per pixel for the first order). The last
+  // projector's planes share the smoothed image's memory, so they hold until the next run().
   [[nodiscard]] ImageView<const std::int16_t> separated(int projector, int channel) const;
 
  private:
@@ -129,6 +129,7 @@ class Demultiplexer {
   std::array<std::array<ImageView<std::int16_t>, 3>, kMaxProjectors> separated_;
   std::array<ImageView<std::uint8_t>, kMaxProjectors> order_;
   ImageView<std::uint16_t> strength_;
+  ImageView<std::uint16_t> derivativeStrength_;
   std::array<BoundaryPlane, kMaxProjectors> boundaries_;
   std::array<DirectionPlane, kMaxProjectors> directions_;
 };
