@@ -95,37 +95,27 @@ std::int16_t relativeToColour(std::int16_t d, std::int16_t high, std::int16_t lo
   return static_cast<std::int16_t>(upper < -32768 ? -32768 : upper);
 }
 
-// A tile row's divisor per pixel: per run of pixels sharing the nearest tile, its inverse colour.
+// A tile row's divisor per pixel: its nearest tile's inverse colour (once per tile row).
 void inverseColourRow(const TileColours& colours, int tileRow, const InverseRow& out) {
   const std::uint32_t* inverse =
       colours.inverse.data() +
       static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(colours.tilesX) * 3;
-  const auto w = static_cast<int>(colours.columns.size());
-  for (int x0 = 0; x0 < w;) {
-    const std::int16_t tile = colours.columns[static_cast<std::size_t>(x0)].nearest;
-    int x1 = x0 + 1;
-    while (x1 < w && colours.columns[static_cast<std::size_t>(x1)].nearest == tile) {
-      ++x1;
-    }
+  for (std::size_t x = 0; x < colours.columns.size(); ++x) {
+    const auto tile = static_cast<std::size_t>(colours.columns[x].nearest);
     for (std::size_t c = 0; c < 3; ++c) {
-      const std::uint32_t inv = inverse[static_cast<std::size_t>(tile) * 3 + c];
-      std::fill(out.high[c] + x0, out.high[c] + x1,
-                static_cast<std::int16_t>(inv >> kInverseSplit));
-      std::fill(out.low[c] + x0, out.low[c] + x1,
-                static_cast<std::int16_t>(inv & ((1U << kInverseSplit) - 1)));
+      const std::uint32_t inv = inverse[tile * 3 + c];
+      out.high[c][x] = static_cast<std::int16_t>(inv >> kInverseSplit);
+      out.low[c][x] = static_cast<std::int16_t>(inv & ((1U << kInverseSplit) - 1));
     }
-    x0 = x1;
   }
 }
 
-// One row of the three separated planes and its inverse colour: the per-channel row pointers
-// and strides, looked up once per row instead of once per sample.
+// One row of the three separated planes and its divisor, looked up once per row.
 class SeparatedRow {
  public:
   SeparatedRow(const Planes3& separated, const InverseRow& inverse, int y) : inverse_(inverse) {
     for (std::size_t c = 0; c < 3; ++c) {
       row_[c] = separated[c].rowPtr(y);
-      stride_[c] = strideOf(separated[c]);
     }
   }
 
@@ -145,7 +135,6 @@ class SeparatedRow {
 
  private:
   const std::int16_t* row_[3] = {};
-  std::ptrdiff_t stride_[3] = {};
   InverseRow inverse_;
 };
 
@@ -157,6 +146,11 @@ Response secondOrderResponse(const Response& behind, const Response& ahead) {
     r.n[c] = behind.n[c] - ahead.n[c];
   }
   return r;
+}
+
+// max − min of three int16 values, which fits uint16.
+std::uint16_t spread(std::int16_t a, std::int16_t b, std::int16_t c) {
+  return static_cast<std::uint16_t>(std::max({a, b, c}) - std::min({a, b, c}));
 }
 
 Boundary classify(const Response& r) {
@@ -411,20 +405,17 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     std::fill_n(s, n, std::uint16_t{0});
     std::fill_n(sd, n, std::uint16_t{0});
   } else {
+    SMX_IVDEP
     for (int i = 0; i < n; ++i) {
-      // |D| < 2^14: max − min fits uint16.
-      const std::int16_t hi = std::max({v[0][i], v[1][i], v[2][i]});
-      const std::int16_t lo = std::min({v[0][i], v[1][i], v[2][i]});
-      sd[i] = o[i] == 1 ? static_cast<std::uint16_t>(hi - lo) : std::uint16_t{0};
+      const std::uint16_t r = spread(v[0][i], v[1][i], v[2][i]);  // unconditional: vectorises
+      sd[i] = o[i] == 1 ? r : std::uint16_t{0};
     }
     SMX_IVDEP
     for (int i = 0; i < n; ++i) {
       const std::int16_t n0 = relativeToColour(v[0][i], inv.high[0][i], inv.low[0][i]);
       const std::int16_t n1 = relativeToColour(v[1][i], inv.high[1][i], inv.low[1][i]);
       const std::int16_t n2 = relativeToColour(v[2][i], inv.high[2][i], inv.low[2][i]);
-      const std::int16_t hi = std::max({n0, n1, n2});
-      const std::int16_t lo = std::min({n0, n1, n2});
-      s[i] = o[i] == 1 ? static_cast<std::uint16_t>(hi - lo) : std::uint16_t{0};
+      s[i] = o[i] == 1 ? spread(n0, n1, n2) : std::uint16_t{0};
     }
   }
   if (anySecond == 0) {
@@ -438,8 +429,8 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
       samplesRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, samples[c], samples[3 + c]);
     }
   });
-  // The response: per channel the difference (|D| < 2^14: it fits int16, and its max − min
-  // uint16), then relative to the colour. Simple loops, each of which vectorises.
+  // The response: per channel the difference (|D| < 2^14: it fits int16), then relative to the
+  // colour. Simple loops, each of which vectorises.
   std::int16_t response[3][kChunkPx];
   for (std::size_t c = 0; c < 3; ++c) {
     for (int i = 0; i < n; ++i) {
@@ -447,9 +438,8 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     }
   }
   for (int i = 0; i < n; ++i) {
-    const std::int16_t hi = std::max({response[0][i], response[1][i], response[2][i]});
-    const std::int16_t lo = std::min({response[0][i], response[1][i], response[2][i]});
-    sd[i] = o[i] == 2 ? static_cast<std::uint16_t>(hi - lo) : sd[i];
+    const std::uint16_t r = spread(response[0][i], response[1][i], response[2][i]);
+    sd[i] = o[i] == 2 ? r : sd[i];
   }
   for (std::size_t c = 0; c < 3; ++c) {
     SMX_IVDEP
@@ -458,9 +448,8 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     }
   }
   for (int i = 0; i < n; ++i) {
-    const std::int16_t hi = std::max({response[0][i], response[1][i], response[2][i]});
-    const std::int16_t lo = std::min({response[0][i], response[1][i], response[2][i]});
-    s[i] = o[i] == 2 ? static_cast<std::uint16_t>(hi - lo) : s[i];
+    const std::uint16_t r = spread(response[0][i], response[1][i], response[2][i]);
+    s[i] = o[i] == 2 ? r : s[i];
   }
   for (int j = 0; j < 6; ++j) {
     std::copy_n(samples[j], n, ring.at(y, j, x0));
@@ -495,17 +484,11 @@ struct Candidate {
   std::int32_t behind;
 };
 
-// The strength planes as the maxima read them.
-struct Strengths {
-  ImageView<const std::uint16_t> relative;
-  ImageView<const std::uint16_t> derivative;
-};
-
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
-Boundary boundaryAt(const SeparatedRow& row, const Strengths& strengths, std::uint8_t order,
+Boundary boundaryAt(const SeparatedRow& row, const StrengthPlanes& strengths, std::uint8_t order,
                     std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
                     const Candidate& c) {
-  const ImageView<const std::uint16_t>& st = strengths.relative;
+  const ImageView<const std::uint16_t> st = strengths.relative;
   const int w = st.width();
   const int h = st.height();
   const int x = c.x;
@@ -569,10 +552,10 @@ std::uint64_t withoutByte(std::uint64_t word, int byte) {
 // Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
 // (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
 // the strength), then the costly rest on the maxima only, found eight flags at a time.
-void maximaChunk(const SeparatedRow& row, const Strengths& strengths, const std::uint8_t* o,
+void maximaChunk(const SeparatedRow& row, const StrengthPlanes& strengths, const std::uint8_t* o,
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
-  const ImageView<const std::uint16_t>& st = strengths.relative;
+  const ImageView<const std::uint16_t> st = strengths.relative;
   const std::uint16_t* s = st.rowPtr(y) + x0;
   ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
   chunkTaps(d + x0, units, n, taps);
@@ -603,10 +586,10 @@ void maximaChunk(const SeparatedRow& row, const Strengths& strengths, const std:
 
 namespace {
 
-// Row y of the strength planes, with its tile row's divisor.
+// Row y of the strength planes, with its tile row's divisor (in the ring).
 void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
                  ConstDirectionPlane direction, const UnitsQ8& units, const SampleRing& ring,
-                 const InverseRow& inverse, int y, const StrengthPlanes& strengths) {
+                 int tileRow, int y, const StrengthPlanes& strengths) {
   const int w = separated[0].width();
   const int h = separated[0].height();
   std::uint16_t* s = strengths.relative.rowPtr(y);
@@ -624,12 +607,8 @@ void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
   const std::uint16_t* d = direction.rowPtr(y);
   for (int x0 = kMargin; x0 < w - kMargin; x0 += kChunkPx) {
     const int n = std::min(kChunkPx, w - kMargin - x0);
-    InverseRow inv = inverse;
-    for (std::size_t c = 0; c < 3; ++c) {
-      inv.high[c] += x0;
-      inv.low[c] += x0;
-    }
-    strengthChunk(separated, o + x0, d + x0, units, ring, inv, y, x0, n, s + x0, sd + x0);
+    strengthChunk(separated, o + x0, d + x0, units, ring, ring.inverse(tileRow, x0), y, x0, n,
+                  s + x0, sd + x0);
   }
 }
 
@@ -638,7 +617,7 @@ void strengthRow(const Planes3& separated, ImageView<const std::uint8_t> order,
 void maximaRow(const Planes3& separated, ImageView<const std::uint8_t> order,
                ConstDirectionPlane direction, const UnitsQ8& unitsQ8, const UnitTable& units,
                const SampleRing& ring, const InverseRow& inverse, int minStrength,
-               const Strengths& strengths, int y, BoundaryPlane out) {
+               const StrengthPlanes& strengths, int y, BoundaryPlane out) {
   const int w = separated[0].width();
   const int h = separated[0].height();
   Boundary* b = out.rowPtr(y);
@@ -671,7 +650,6 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
   const int h = separated[0].height();
   const UnitsQ8 unitsQ8(units);
   const SampleRing ring(ringRows);
-  const Strengths read{strengths.relative, strengths.derivative};
   const auto tileRowOf = [&](int y) { return colours.rows[static_cast<std::size_t>(y)].nearest; };
   int divisorRow = -1;
   // Row by row, the maxima kStrengthAhead rows behind the strength, while the samples they
@@ -682,13 +660,12 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
         divisorRow = tileRowOf(y);
         inverseColourRow(colours, divisorRow, ring.inverse(divisorRow, 0));
       }
-      strengthRow(separated, order, direction, unitsQ8, ring, ring.inverse(divisorRow, 0), y,
-                  strengths);
+      strengthRow(separated, order, direction, unitsQ8, ring, divisorRow, y, strengths);
     }
     if (y >= kStrengthAhead) {
       const int m = y - kStrengthAhead;
       maximaRow(separated, order, direction, unitsQ8, units, ring, ring.inverse(tileRowOf(m), 0),
-                minStrength, read, m, out);
+                minStrength, strengths, m, out);
     }
   }
 }
