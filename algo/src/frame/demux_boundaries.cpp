@@ -76,23 +76,31 @@ struct Response {
   std::int32_t n[3];
 };
 
-// A row of the divisor per channel, int16 high (>> kInverseSplit) and low (& 15) parts of the
-// inverse colour (<= 2^24 / kColourFloor = 2^17), so that the product below stays in int32.
-constexpr int kInverseSplit = 4;
+// A row of the divisor per channel: the inverse colour (<= 2^24 / kColourFloor = 2^17) scaled
+// into int16 (>> kScaleShift, rounded: <= 0.2 % off, far below the noise), and the largest |D|
+// whose relative value fits int16.
+constexpr int kScaleShift = 4;
 struct InverseRow {
-  std::int16_t* high[3];
-  std::int16_t* low[3];
+  std::int16_t* scale[3];
+  std::int16_t* bound[3];
 };
 
-// D · inverse >> (kInverseShift − kRelativeShift): Q4.11 relative to the average colour,
-// saturated to int16, as the exact product would give: with inverse = 16·high + low,
-// D · inverse >> 13 = (D · high + (D · low >> 4)) >> 9 (floor division nests), and
-// D · high < 2^15 · 2^13 fits int32.
-std::int16_t relativeToColour(std::int16_t d, std::int16_t high, std::int16_t low) {
-  constexpr int kShift = kInverseShift - kRelativeShift - kInverseSplit;
-  const std::int32_t scaled = (d * high + ((d * low) >> kInverseSplit)) >> kShift;
-  const std::int32_t upper = scaled > 32767 ? 32767 : scaled;
-  return static_cast<std::int16_t>(upper < -32768 ? -32768 : upper);
+// D · scale >> kRelativeProductShift: Q4.11 relative to the average colour, D clamped to the
+// bound first so that the result fits int16 (at most 16 below saturation). Since it fits, its
+// 16 bits are the product's high half shifted up and low half shifted down: int16 operations
+// only, the two halves being the vector units' native int16 products (SSE2 pmulhw and pmullw);
+// written as one int32 product and a narrowing, GCC shuffles the halves together and apart.
+constexpr int kRelativeProductShift = kInverseShift - kRelativeShift - kScaleShift;
+std::int16_t relativeToColour(std::int16_t d, std::int16_t scale, std::int16_t bound) {
+  const std::int16_t upper = d > bound ? bound : d;
+  const auto lowest = static_cast<std::int16_t>(-bound);
+  const std::int16_t clamped = upper < lowest ? lowest : upper;
+  const auto high = static_cast<std::int16_t>((clamped * scale) >> 16);
+  const auto low = static_cast<std::uint16_t>(static_cast<std::uint16_t>(clamped) *
+                                              static_cast<std::uint16_t>(scale));
+  return static_cast<std::int16_t>(
+      static_cast<std::uint16_t>(high << (16 - kRelativeProductShift)) |
+      static_cast<std::uint16_t>(low >> kRelativeProductShift));
 }
 
 // A tile row's divisor per pixel: its nearest tile's inverse colour (once per tile row).
@@ -100,43 +108,38 @@ void inverseColourRow(const TileColours& colours, int tileRow, const InverseRow&
   const std::uint32_t* inverse =
       colours.inverse.data() +
       static_cast<std::size_t>(tileRow) * static_cast<std::size_t>(colours.tilesX) * 3;
+  std::int16_t scale[3] = {};
+  std::int16_t bound[3] = {};
+  std::size_t lastTile = colours.columns.size() + 1;  // no tile: the first pixel sets them
   for (std::size_t x = 0; x < colours.columns.size(); ++x) {
     const auto tile = static_cast<std::size_t>(colours.columns[x].nearest);
+    if (tile != lastTile) {  // runs of tilePx pixels
+      lastTile = tile;
+      for (std::size_t c = 0; c < 3; ++c) {
+        constexpr std::uint32_t kRound = 1U << (kScaleShift - 1);
+        const std::uint32_t scaled = (inverse[tile * 3 + c] + kRound) >> kScaleShift;
+        constexpr std::uint32_t kLargest = 32767U << kRelativeProductShift;
+        const std::uint32_t largest = kLargest / scaled;
+        scale[c] = static_cast<std::int16_t>(scaled);
+        bound[c] = static_cast<std::int16_t>(largest > 32767U ? 32767U : largest);
+      }
+    }
     for (std::size_t c = 0; c < 3; ++c) {
-      const std::uint32_t inv = inverse[tile * 3 + c];
-      out.high[c][x] = static_cast<std::int16_t>(inv >> kInverseSplit);
-      out.low[c][x] = static_cast<std::int16_t>(inv & ((1U << kInverseSplit) - 1));
+      out.scale[c][x] = scale[c];
+      out.bound[c][x] = bound[c];
     }
   }
 }
 
-// One row of the three separated planes and its divisor, looked up once per row.
-class SeparatedRow {
- public:
-  SeparatedRow(const Planes3& separated, const InverseRow& inverse, int y) : inverse_(inverse) {
-    for (std::size_t c = 0; c < 3; ++c) {
-      row_[c] = separated[c].rowPtr(y);
-    }
+// Separated values (samples around pixel x) relative to the colour at x.
+Response relativeAt(const InverseRow& inverse, const Response& d, int x) {
+  Response r{};
+  for (std::size_t c = 0; c < 3; ++c) {
+    r.n[c] = relativeToColour(static_cast<std::int16_t>(d.n[c]), inverse.scale[c][x],
+                              inverse.bound[c][x]);
   }
-
-  // The three channels' relative values at (x, y).
-  [[nodiscard]] Response at(int x) const {
-    return relative({{row_[0][x], row_[1][x], row_[2][x]}}, x);
-  }
-  // Separated values (samples around x) relative to the colour at (x, y).
-  [[nodiscard]] Response relative(const Response& d, int x) const {
-    Response r{};
-    for (std::size_t c = 0; c < 3; ++c) {
-      r.n[c] = relativeToColour(static_cast<std::int16_t>(d.n[c]), inverse_.high[c][x],
-                                inverse_.low[c][x]);
-    }
-    return r;
-  }
-
- private:
-  const std::int16_t* row_[3] = {};
-  InverseRow inverse_;
-};
+  return r;
+}
 
 // Second order: the difference of the separated values one pixel behind and ahead along the
 // encoding direction, per channel.
@@ -296,26 +299,26 @@ void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t
   }
 }
 
-// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n); mostly one run.
+// Calls f(i0, i1, code) for each run of equal codes in [0, n); mostly one run.
 template <class F>
-void forEachRun(const ChunkTaps& t, int n, F&& f) {
+void forEachRun(const std::uint8_t* codes, int n, F&& f) {
   if (n <= 0) {
     return;
   }
   unsigned differs = 0;
   for (int i = 0; i < n; ++i) {
-    differs |= static_cast<unsigned>(t.offsets[i] ^ t.offsets[0]);
+    differs |= static_cast<unsigned>(codes[i] ^ codes[0]);
   }
   if (differs == 0) {
-    f(0, n, offsetsOf(t.offsets[0]));
+    f(0, n, codes[0]);
     return;
   }
   for (int i0 = 0; i0 < n;) {
     int i1 = i0 + 1;
-    while (i1 < n && t.offsets[i1] == t.offsets[i0]) {
+    while (i1 < n && codes[i1] == codes[i0]) {
       ++i1;
     }
-    f(i0, i1, offsetsOf(t.offsets[i0]));
+    f(i0, i1, codes[i0]);
     i0 = i1;
   }
 }
@@ -352,10 +355,11 @@ void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTa
   }
 }
 
-// The working rows: the second-order samples of D (behind per channel, then ahead per channel) of
-// the last rows the strength pass computed, kept for the maxima found three rows later (row y's
-// six rows in slot y mod kBoundaryRingSlots), and the divisor of the last two tile rows (tile
-// row t's six rows in slot t mod 2: the maxima trail the strength by fewer rows than a tile has).
+// The working rows: the second-order samples of D (behind per channel, then ahead per channel)
+// and the relative values per channel of the last rows the strength pass computed, kept for the
+// maxima found three rows later (row y's nine rows in slot y mod kBoundaryRingSlots), and the
+// divisor of the last two tile rows (tile row t's six rows in slot t mod 2: the maxima trail the
+// strength by fewer rows than a tile has).
 class SampleRing {
  public:
   explicit SampleRing(const RowBlock<std::int16_t>& rows) : rows_(rows) {}
@@ -363,24 +367,27 @@ class SampleRing {
   // Sample j (0–5) of pixel x of row y.
   [[nodiscard]] std::int16_t* at(int y, int j, int x) const {
     const std::size_t slot = static_cast<std::size_t>(y) % kBoundaryRingSlots;
-    return rows_.row(slot * kSamples + static_cast<std::size_t>(j)) + x;
+    return rows_.row(slot * kSlotRows + static_cast<std::size_t>(j)) + x;
   }
+  // Channel c's relative value of pixel x of row y.
+  [[nodiscard]] std::int16_t* relative(int y, int c, int x) const { return at(y, kSamples + c, x); }
 
   // Tile row t's divisor, from pixel x on.
   [[nodiscard]] InverseRow inverse(int tileRow, int x) const {
     const std::size_t first =
-        kBoundaryRingSlots * kSamples + static_cast<std::size_t>(tileRow % 2) * 6;
+        kBoundaryRingSlots * kSlotRows + static_cast<std::size_t>(tileRow % 2) * 6;
     InverseRow r{};
     for (std::size_t c = 0; c < 3; ++c) {
-      r.high[c] = rows_.row(first + c) + x;
-      r.low[c] = rows_.row(first + 3 + c) + x;
+      r.scale[c] = rows_.row(first + c) + x;
+      r.bound[c] = rows_.row(first + 3 + c) + x;
     }
     return r;
   }
 
  private:
-  static constexpr std::size_t kSamples = 6;
-  static_assert(kBoundaryRingRows == kBoundaryRingSlots * kSamples + std::size_t{2} * 6);
+  static constexpr int kSamples = 6;
+  static constexpr std::size_t kSlotRows = kSamples + 3;
+  static_assert(kBoundaryRingRows == kBoundaryRingSlots * kSlotRows + std::size_t{2} * 6);
   RowBlock<std::int16_t> rows_;
 };
 
@@ -401,6 +408,19 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     anyFirst |= static_cast<unsigned>(o[i] == 1);
     anySecond |= static_cast<unsigned>(o[i] == 2);
   }
+  // The pixels' relative values, which the boundaries found at them classify.
+  std::int16_t* relative[3];
+  for (int c = 0; c < 3; ++c) {
+    relative[c] = ring.relative(y, c, x0);
+  }
+  if ((anyFirst | anySecond) != 0) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      SMX_IVDEP
+      for (int i = 0; i < n; ++i) {
+        relative[c][i] = relativeToColour(v[c][i], inv.scale[c][i], inv.bound[c][i]);
+      }
+    }
+  }
   if (anyFirst == 0) {
     std::fill_n(s, n, std::uint16_t{0});
     std::fill_n(sd, n, std::uint16_t{0});
@@ -412,10 +432,8 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
     }
     SMX_IVDEP
     for (int i = 0; i < n; ++i) {
-      const std::int16_t n0 = relativeToColour(v[0][i], inv.high[0][i], inv.low[0][i]);
-      const std::int16_t n1 = relativeToColour(v[1][i], inv.high[1][i], inv.low[1][i]);
-      const std::int16_t n2 = relativeToColour(v[2][i], inv.high[2][i], inv.low[2][i]);
-      s[i] = o[i] == 1 ? spread(n0, n1, n2) : std::uint16_t{0};
+      const std::uint16_t r = spread(relative[0][i], relative[1][i], relative[2][i]);
+      s[i] = o[i] == 1 ? r : std::uint16_t{0};
     }
   }
   if (anySecond == 0) {
@@ -424,9 +442,10 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
   chunkTaps(d, units, n, taps);
   std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
-  forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
+  forEachRun(taps.offsets, n, [&](int i0, int i1, std::uint8_t code) {
     for (std::size_t c = 0; c < 3; ++c) {
-      samplesRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, samples[c], samples[3 + c]);
+      samplesRun(v[c], strideOf(separated[c]), taps, offsetsOf(code), i0, i1, samples[c],
+                 samples[3 + c]);
     }
   });
   // The response: per channel the difference (|D| < 2^14: it fits int16), then relative to the
@@ -444,7 +463,7 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   for (std::size_t c = 0; c < 3; ++c) {
     SMX_IVDEP
     for (int i = 0; i < n; ++i) {
-      response[c][i] = relativeToColour(response[c][i], inv.high[c][i], inv.low[c][i]);
+      response[c][i] = relativeToColour(response[c][i], inv.scale[c][i], inv.bound[c][i]);
     }
   }
   for (int i = 0; i < n; ++i) {
@@ -464,7 +483,8 @@ struct ChunkSamples {
 
 void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t, int n,
                      ChunkSamples& out) {
-  forEachRun(t, n, [&](int i0, int i1, const RunOffsets& o) {
+  forEachRun(t.offsets, n, [&](int i0, int i1, std::uint8_t code) {
+    const RunOffsets o = offsetsOf(code);
     const std::uint16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
     const std::uint16_t* b1 = b0 + stride;
     const std::uint16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
@@ -476,22 +496,12 @@ void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const C
   });
 }
 
-// Where the strength at x is at least the minimum and no less than the bilinear sample one pixel
-// ahead along the encoding direction and more than the one behind.
-struct Candidate {
-  int x;
-  std::int32_t ahead;
-  std::int32_t behind;
-};
-
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
-Boundary boundaryAt(const SeparatedRow& row, const StrengthPlanes& strengths, std::uint8_t order,
-                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
-                    const Candidate& c) {
+Boundary boundaryAt(const InverseRow& inverse, const StrengthPlanes& strengths, std::uint8_t order,
+                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int x, int y) {
   const ImageView<const std::uint16_t> st = strengths.relative;
   const int w = st.width();
   const int h = st.height();
-  const int x = c.x;
   const std::uint16_t* here = st.rowPtr(y) + x;
   const std::int32_t s0 = *here;
   // A second-order response has side lobes of about half the peak two pixels out, with the
@@ -505,10 +515,18 @@ Boundary boundaryAt(const SeparatedRow& row, const StrengthPlanes& strengths, st
     }
   }
   // Where a finer estimate does not apply: the vertex through the strength plane's samples.
-  const auto strengthVertex = [&] { return vertexQ8(c.behind, s0, c.ahead).value_or(0); };
+  const auto strengthVertex = [&] {
+    const TapPair near = tapsAlong(ux, uy, 6);
+    const std::ptrdiff_t stride = strideOf(st);
+    return vertexQ8(sampleAt(here, stride, near.behind), s0, sampleAt(here, stride, near.ahead))
+        .value_or(0);
+  };
   std::int32_t offset = 0;
   Boundary found;
-  const Response hereValues = row.at(x);
+  Response hereValues{};
+  for (int c = 0; c < 3; ++c) {
+    hereValues.n[c] = *ring.relative(y, c, x);
+  }
   if (order == 1) {
     found = classify(hereValues);
     // The position from the derivative itself: the strength plane's samples have each their
@@ -528,8 +546,8 @@ Boundary boundaryAt(const SeparatedRow& row, const StrengthPlanes& strengths, st
       behindSamples.n[k] = *ring.at(y, channel, x);
       aheadSamples.n[k] = *ring.at(y, 3 + channel, x);
     }
-    behindSamples = row.relative(behindSamples, x);
-    aheadSamples = row.relative(aheadSamples, x);
+    behindSamples = relativeAt(inverse, behindSamples, x);
+    aheadSamples = relativeAt(inverse, aheadSamples, x);
     found = classify(secondOrderResponse(behindSamples, aheadSamples));
     const auto z = zeroCrossingQ8(found, behindSamples, hereValues, aheadSamples);
     offset = z ? *z : strengthVertex();
@@ -552,7 +570,7 @@ std::uint64_t withoutByte(std::uint64_t word, int byte) {
 // Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
 // (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
 // the strength), then the costly rest on the maxima only, found eight flags at a time.
-void maximaChunk(const SeparatedRow& row, const StrengthPlanes& strengths, const std::uint8_t* o,
+void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, const std::uint8_t* o,
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
   const ImageView<const std::uint16_t> st = strengths.relative;
@@ -574,10 +592,9 @@ void maximaChunk(const SeparatedRow& row, const StrengthPlanes& strengths, const
     while (flags != 0) {
       const int byte = firstByte(flags);
       flags = withoutByte(flags, byte);
-      const int i = i8 + byte;
-      const int x = x0 + i;
-      b[x] = boundaryAt(row, strengths, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]), ring, y,
-                        {x, samples.ahead[i], samples.behind[i]});
+      const int x = x0 + i8 + byte;
+      b[x] = boundaryAt(inverse, strengths, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
+                        ring, x, y);
     }
   }
 }
@@ -627,10 +644,9 @@ void maximaRow(const Planes3& separated, ImageView<const std::uint8_t> order,
   }
   const std::uint8_t* o = order.rowPtr(y);
   const std::uint16_t* d = direction.rowPtr(y);
-  const SeparatedRow row(separated, inverse, y);
   for (int x0 = kMargin + 1; x0 < w - kMargin - 1; x0 += kChunkPx) {
     const int n = std::min(kChunkPx, w - kMargin - 1 - x0);
-    maximaChunk(row, strengths, o, d, unitsQ8, units, ring, minStrength, y, x0, n, b);
+    maximaChunk(inverse, strengths, o, d, unitsQ8, units, ring, minStrength, y, x0, n, b);
   }
 }
 

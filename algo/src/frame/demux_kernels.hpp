@@ -159,10 +159,10 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
 // Stages 4–5 for one projector: the response relative to the local colour, its strength
 // max − min over the channels, then non-maximum suppression along the encoding direction,
 // sub-pixel offset and class. ringRows: a ring of kBoundaryRingRows working rows of the image's
-// width (run() lends separate()'s) keeping the second-order samples of the last
-// kBoundaryRingSlots strength rows for their maxima, and the divisor of two tile rows.
+// width (run() lends separate()'s) keeping the relative values and second-order samples of the
+// last kBoundaryRingSlots strength rows for their maxima, and the divisor of two tile rows.
 inline constexpr std::size_t kBoundaryRingSlots = 4;
-inline constexpr std::size_t kBoundaryRingRows = kBoundaryRingSlots * 6 + std::size_t{2} * 6;
+inline constexpr std::size_t kBoundaryRingRows = kBoundaryRingSlots * 9 + std::size_t{2} * 6;
 // The int16 working rows run() carves: separate()'s, then detectBoundaries()' ring.
 inline constexpr std::size_t kSharedWorkRows =
     kWorkRows > kBoundaryRingRows ? kWorkRows : kBoundaryRingRows;
