@@ -66,10 +66,9 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
           slope = d10 * (256 - wy) + (d11 - d01) * wy;  // |slope| < 2^25
           base = d01 * wy + 128;                        // |base| < 2^23
         }
-        // wx·slope + 256·base overflows int32; its >> 16 is taken as
-        // (wx·(slope >> 8) + base + (wx·(slope & 255) >> 8)) >> 8, the same integer.
-        const std::int32_t wx = cx.weight;
-        const std::int32_t delta = (wx * (slope >> 8) + base + ((wx * (slope & 255)) >> 8)) >> 8;
+        // wx·slope + 256·base overflows int32; in int64 it is one scalar multiply-add.
+        const std::int64_t sum = std::int64_t{cx.weight} * slope + std::int64_t{base} * 256;
+        const auto delta = static_cast<std::int32_t>(sum >> 16);
         dst[x] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
       }
     }
