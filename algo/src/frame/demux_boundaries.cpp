@@ -341,7 +341,18 @@ const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
   return pixel0 + static_cast<std::ptrdiff_t>(dy) * stride + dx;
 }
 
-// One channel's samples behind and ahead over a run.
+// (a·(256 − f) + b·f) / 256 for int16 a, b with |b − a| < 2^15 and f in [0, 255], in int16
+// lanes: the product's high half (b − a)·(128·f) >> 16 is a native int16 vector multiply (SSE2
+// pmulhw), where bilinear()'s int32 products are emulated. Rounded down to even units: under 2
+// units of D (1/16 grey level per pixel) low, the same for every sample.
+std::int16_t blend16(std::int16_t a, std::int16_t b, std::int16_t f) {
+  const auto diff = static_cast<std::int16_t>(b - a);
+  const auto f128 = static_cast<std::int16_t>(f << 7);
+  const auto half = static_cast<std::int16_t>((diff * f128) >> 16);
+  return static_cast<std::int16_t>(a + 2 * half);
+}
+
+// One channel's samples behind and ahead over a run (|D| < 2^14: differences fit int16).
 void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t,
                 const RunOffsets& o, int i0, int i1, std::int16_t* behind, std::int16_t* ahead) {
   const std::int16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
@@ -349,9 +360,11 @@ void samplesRun(const std::int16_t* pixel0, std::ptrdiff_t stride, const ChunkTa
   const std::int16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
   const std::int16_t* a1 = a0 + stride;
   for (int i = i0; i < i1; ++i) {
-    // A bilinear sample lies between its corners' values: int16.
-    behind[i] = static_cast<std::int16_t>(bilinear(b0, b1, t.behind, i));
-    ahead[i] = static_cast<std::int16_t>(bilinear(a0, a1, t.ahead, i));
+    const std::int16_t bx = t.behind.x1[i];
+    const std::int16_t ax = t.ahead.x1[i];
+    behind[i] =
+        blend16(blend16(b0[i], b0[i + 1], bx), blend16(b1[i], b1[i + 1], bx), t.behind.y1[i]);
+    ahead[i] = blend16(blend16(a0[i], a0[i + 1], ax), blend16(a1[i], a1[i + 1], ax), t.ahead.y1[i]);
   }
 }
 
