@@ -299,26 +299,26 @@ void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t
   }
 }
 
-// Calls f(i0, i1, code) for each run of equal codes in [0, n); mostly one run.
+// Calls f(i0, i1, offsets) for each run of equal offsets in [0, n); mostly one run.
 template <class F>
-void forEachRun(const std::uint8_t* codes, int n, F&& f) {
+void forEachRun(const ChunkTaps& t, int n, F&& f) {
   if (n <= 0) {
     return;
   }
   unsigned differs = 0;
   for (int i = 0; i < n; ++i) {
-    differs |= static_cast<unsigned>(codes[i] ^ codes[0]);
+    differs |= static_cast<unsigned>(t.offsets[i] ^ t.offsets[0]);
   }
   if (differs == 0) {
-    f(0, n, codes[0]);
+    f(0, n, offsetsOf(t.offsets[0]));
     return;
   }
   for (int i0 = 0; i0 < n;) {
     int i1 = i0 + 1;
-    while (i1 < n && codes[i1] == codes[i0]) {
+    while (i1 < n && t.offsets[i1] == t.offsets[i0]) {
       ++i1;
     }
-    f(i0, i1, codes[i0]);
+    f(i0, i1, offsetsOf(t.offsets[i0]));
     i0 = i1;
   }
 }
@@ -455,10 +455,9 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
   chunkTaps(d, units, n, taps);
   std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
-  forEachRun(taps.offsets, n, [&](int i0, int i1, std::uint8_t code) {
+  forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
     for (std::size_t c = 0; c < 3; ++c) {
-      samplesRun(v[c], strideOf(separated[c]), taps, offsetsOf(code), i0, i1, samples[c],
-                 samples[3 + c]);
+      samplesRun(v[c], strideOf(separated[c]), taps, offsets, i0, i1, samples[c], samples[3 + c]);
     }
   });
   // The response: per channel the difference (|D| < 2^14: it fits int16), then relative to the
@@ -496,8 +495,7 @@ struct ChunkSamples {
 
 void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t, int n,
                      ChunkSamples& out) {
-  forEachRun(t.offsets, n, [&](int i0, int i1, std::uint8_t code) {
-    const RunOffsets o = offsetsOf(code);
+  forEachRun(t, n, [&](int i0, int i1, const RunOffsets& o) {
     const std::uint16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
     const std::uint16_t* b1 = b0 + stride;
     const std::uint16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
@@ -509,9 +507,19 @@ void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const C
   });
 }
 
+// Where the strength at x is at least the minimum and no less than the bilinear sample one pixel
+// ahead along the encoding direction and more than the one behind.
+struct Candidate {
+  int x;
+  std::int32_t ahead;
+  std::int32_t behind;
+};
+
 // The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
 Boundary boundaryAt(const InverseRow& inverse, const StrengthPlanes& strengths, std::uint8_t order,
-                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int x, int y) {
+                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
+                    const Candidate& c) {
+  const int x = c.x;
   const ImageView<const std::uint16_t> st = strengths.relative;
   const int w = st.width();
   const int h = st.height();
@@ -528,17 +536,12 @@ Boundary boundaryAt(const InverseRow& inverse, const StrengthPlanes& strengths, 
     }
   }
   // Where a finer estimate does not apply: the vertex through the strength plane's samples.
-  const auto strengthVertex = [&] {
-    const TapPair near = tapsAlong(ux, uy, 6);
-    const std::ptrdiff_t stride = strideOf(st);
-    return vertexQ8(sampleAt(here, stride, near.behind), s0, sampleAt(here, stride, near.ahead))
-        .value_or(0);
-  };
+  const auto strengthVertex = [&] { return vertexQ8(c.behind, s0, c.ahead).value_or(0); };
   std::int32_t offset = 0;
   Boundary found;
   Response hereValues{};
-  for (int c = 0; c < 3; ++c) {
-    hereValues.n[c] = *ring.relative(y, c, x);
+  for (int channel = 0; channel < 3; ++channel) {
+    hereValues.n[channel] = *ring.relative(y, channel, x);
   }
   if (order == 1) {
     found = classify(hereValues);
@@ -605,9 +608,10 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
     while (flags != 0) {
       const int byte = firstByte(flags);
       flags = withoutByte(flags, byte);
-      const int x = x0 + i8 + byte;
+      const int i = i8 + byte;
+      const int x = x0 + i;
       b[x] = boundaryAt(inverse, strengths, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
-                        ring, x, y);
+                        ring, y, {x, samples.ahead[i], samples.behind[i]});
     }
   }
 }
