@@ -10,14 +10,19 @@
 // with camera 0 scaled to 1280×960.
 // Per configuration:
 //   <cfg>/sobel        cv::Sobel(frame, dst, CV_16S, 1, 0, 3) on the frame as CV_8UC3;
-//   <cfg>/demux        Demultiplexer::run() (the whole frame; arena from workspaceBytes());
+//   <cfg>/demux        Demultiplexer::run() (the whole frame; arena from workspaceBytes()),
+//                      with the kernels' AVX2 build where the CPU has it (context
+//                      demux_kernels), as OpenCV dispatches its Sobel;
+//   <cfg>/demux_baseline
+//                      the same with DemuxParams::avx2 off: the SSE2 build, what an x86-64
+//                      without AVX2 runs (checked equal to <cfg>/demux's output first);
 //   <cfg>/1_smooth … <cfg>/8_boundaries
-//                      each kernel of algo/src/frame/demux_kernels.hpp alone, wired as run()
-//                      wires them, over buffers owned here (one separated plane set per
-//                      projector, so stage 8 reads what stage 7 wrote for that projector);
-//                      separate and boundaries cover all projectors. Before timing, the stage
-//                      chain is run once and its boundaries and directions are checked equal to
-//                      run()'s.
+//                      each kernel of algo/src/frame/demux_kernels.hpp alone (the build
+//                      <cfg>/demux runs), wired as run() wires them, over buffers owned here (one
+//                      separated plane set per projector, so stage 8 reads what stage 7 wrote for
+//                      that projector); separate and boundaries cover all projectors. Before
+//                      timing, the stage chain is run once and its boundaries and directions are
+//                      checked equal to run()'s.
 //   <cfg>/pipeline     CameraPipeline::run(): demux, decode, triangulate and merge
 //   (docs/decode.md); <cfg>/p_decode, p_triangulate, p_merge
 //                      those stages alone, on the output of the pipeline's last run.
@@ -132,7 +137,8 @@ struct ProjectorOut {
 class Stages {
  public:
   Stages(const algo::DemuxLayout& layout, std::span<const std::uint16_t> predicted)
-      : layout_(layout),
+      : kernels_(kern::fastestKernels()),
+        layout_(layout),
         w_(layout.width),
         h_(layout.height),
         smoothed_(w_, h_),
@@ -168,14 +174,14 @@ class Stages {
   }
 
   void smooth(algo::ConstRgbView image) {
-    kern::smoothChannels(image, smoothed_.views, layout_.params.smoothPasses, rowScratch_);
+    kernels_.smooth(image, smoothed_.views, layout_.params.smoothPasses, rowScratch_);
   }
   void tileSums() { kern::sumTileColours(smoothed_.views, layout_.params.tilePx, tileSums_); }
   void tileInverse() {
     kern::inverseTileColours(tileSums_, layout_, layout_.params.normaliseColour, tileInverse_);
   }
   void histogram() {
-    kern::histogramTiles(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
+    kernels_.histogram(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
   }
   void directions() {
     kern::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
@@ -185,14 +191,14 @@ class Stages {
     kern::interpolateDirections(layout_, tileDirections_, columns_, rows_, directionPlanes());
   }
   void separate() {
-    kern::separate(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_, filterRows_,
-                   workRows_, directionPlanes(),
-                   std::span(separatedPlanes_).first(projectors_.size()),
-                   std::span(orderPlanes_).first(projectors_.size()));
+    kernels_.separation(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_,
+                        filterRows_, workRows_, directionPlanes(),
+                        std::span(separatedPlanes_).first(projectors_.size()),
+                        std::span(orderPlanes_).first(projectors_.size()));
   }
   void boundaries() {
     for (ProjectorOut& out : projectors_) {
-      kern::detectBoundaries(
+      kernels_.boundaries(
           out.separated.views, viewOf(std::span<const std::uint8_t>(out.order), w_, h_),
           viewOf(std::span<const std::uint16_t>(out.direction), w_, h_), units_,
           {tileInverse_, layout_.tilesX(), columns_, rows_}, minStrength_, workRows_,
@@ -232,6 +238,7 @@ class Stages {
   }
 
  private:
+  const kern::Kernels& kernels_;
   algo::DemuxLayout layout_;
   int w_;
   int h_;
@@ -274,6 +281,9 @@ struct Config {
   std::vector<std::byte> memory;
   std::unique_ptr<algo::Arena> arena;
   std::unique_ptr<algo::Demultiplexer> demux;
+  std::vector<std::byte> baselineMemory;  // the same with DemuxParams::avx2 off
+  std::unique_ptr<algo::Arena> baselineArena;
+  std::unique_ptr<algo::Demultiplexer> baseline;
   std::unique_ptr<Stages> stages;
   // The whole pipeline of the same camera (demux, decode, triangulate, merge) over its own arena.
   std::size_t pipelineBytes = 0;
@@ -356,13 +366,25 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int 
     die(c->name + ": create: " + demux.error().message);
   }
   c->demux = std::make_unique<algo::Demultiplexer>(std::move(*demux));
-  if (!c->demux->run(c->image())) {
+  algo::DemuxLayout baselineLayout = c->layout;
+  baselineLayout.params.avx2 = false;
+  c->baselineMemory.resize(*bytes);
+  c->baselineArena = std::make_unique<algo::Arena>(c->baselineMemory);
+  auto baseline = algo::Demultiplexer::create(baselineLayout, *predicted, *c->baselineArena);
+  if (!baseline) {
+    die(c->name + ": create (baseline): " + baseline.error().message);
+  }
+  c->baseline = std::make_unique<algo::Demultiplexer>(std::move(*baseline));
+  if (!c->demux->run(c->image()) || !c->baseline->run(c->image())) {
     die(c->name + ": run failed");
   }
   c->stages = std::make_unique<Stages>(c->layout, *predicted);
   c->stages->all(c->image());
   if (!c->stages->matches(*c->demux)) {
     die(c->name + ": the stage chain's boundaries or directions differ from run()'s");
+  }
+  if (!c->stages->matches(*c->baseline)) {
+    die(c->name + ": the baseline build's boundaries or directions differ from the AVX2 build's");
   }
 
   algo::PipelineOptions options;
@@ -440,6 +462,10 @@ void registerConfig(Config* c) {
     auto ok = c->demux->run(c->image());
     benchmark::DoNotOptimize(ok);
   });
+  add("demux_baseline", [c] {
+    auto ok = c->baseline->run(c->image());
+    benchmark::DoNotOptimize(ok);
+  });
   add("1_smooth", [c, st] { st->smooth(c->image()); });
   add("2_tile_sums", [st] { st->tileSums(); });
   add("3_tile_inverse", [st] { st->tileInverse(); });
@@ -494,6 +520,8 @@ int main(int argc, char** argv) {
 
   benchmark::AddCustomContext("opencv", CV_VERSION);
   benchmark::AddCustomContext("opencv_threads", std::to_string(cv::getNumThreads()));
+  benchmark::AddCustomContext(
+      "demux_kernels", &kern::fastestKernels() == &kern::baselineKernels() ? "baseline" : "avx2");
   for (const auto& c : configs) {
     char ms[64];
     std::snprintf(ms, sizeof ms, "%.4f CPU, %.4f wall", c->sobelSecondsPerCall * 1e3,

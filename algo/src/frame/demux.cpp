@@ -19,6 +19,22 @@ void UnitTable::fill() {
   }
 }
 
+const Kernels& baselineKernels() {
+  static constexpr Kernels kBaseline{smoothChannels, histogramTiles, separate, detectBoundaries};
+  return kBaseline;
+}
+
+const Kernels& fastestKernels() {
+#if SMX_DEMUX_AVX2
+  static constexpr Kernels kAvx2{avx2::smoothChannels, avx2::histogramTiles, avx2::separate,
+                                 avx2::detectBoundaries};
+  if (__builtin_cpu_supports("avx2")) {
+    return kAvx2;
+  }
+#endif
+  return baselineKernels();
+}
+
 }  // namespace demux
 
 namespace {
@@ -129,6 +145,7 @@ Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
   for (std::size_t i = 0; i < predictedAngles.size(); ++i) {
     d.predicted_[i] = predictedAngles[i];
   }
+  d.kernels_ = layout.params.avx2 ? &demux::fastestKernels() : &demux::baselineKernels();
   d.units_[0].fill();
   demux::tileInterpolation(layout.width, layout.params.tilePx, layout.tilesX(), d.columns_);
   demux::tileInterpolation(layout.height, layout.params.tilePx, layout.tilesY(), d.rows_);
@@ -140,15 +157,15 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
     return fail(Errc::kSizeMismatch, "demux: image size differs from the layout");
   }
   const DemuxParams& p = layout_.params;
-  demux::smoothChannels(image, smoothed_, p.smoothPasses, rowScratch_);
+  kernels_->smooth(image, smoothed_, p.smoothPasses, rowScratch_);
   demux::sumTileColours(smoothed_, p.tilePx, tileColourSums_);
   demux::inverseTileColours(tileColourSums_, layout_, p.normaliseColour, tileInverseColour_);
   if (!fixedDirections_) {
     // separate()'s filter rows are free until it runs.
     static_assert(demux::kHistogramRows <= demux::kFilterRows);
-    demux::histogramTiles(smoothed_, layout_,
-                          demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
-                          tileHistograms_, tileMoments_);
+    kernels_->histogram(smoothed_, layout_,
+                        demux::RowBlock<std::int32_t>(filterRows_, layout_.width), tileHistograms_,
+                        tileMoments_);
     demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
                               tileScratch_);
   }
@@ -156,19 +173,19 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   demux::interpolateDirections(layout_, tileDirections_, columns_, rows_,
                                std::span<const DirectionPlane>(directions_.data(), projectors));
   // Every projector separated in one sweep (the derivatives are shared), then its boundaries.
-  demux::separate(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
-                  demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
-                  demux::RowBlock<std::int16_t>(workRows_, layout_.width),
-                  std::span<const DirectionPlane>(directions_.data(), projectors),
-                  std::span<const demux::Planes3>(separated_.data(), projectors),
-                  std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
+  kernels_->separation(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
+                       demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
+                       demux::RowBlock<std::int16_t>(workRows_, layout_.width),
+                       std::span<const DirectionPlane>(directions_.data(), projectors),
+                       std::span<const demux::Planes3>(separated_.data(), projectors),
+                       std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
   // separate() is done with its working rows: they hold detectBoundaries()' ring.
   const demux::TileColours colours{tileInverseColour_, layout_.tilesX(), columns_, rows_};
   for (std::size_t q = 0; q < projectors; ++q) {
-    demux::detectBoundaries(separated_[q], order_[q], directions_[q], units_[0], colours,
-                            demux::minStrengthQ11(p),
-                            demux::RowBlock<std::int16_t>(workRows_, layout_.width),
-                            {strength_, derivativeStrength_}, boundaries_[q]);
+    kernels_->boundaries(separated_[q], order_[q], directions_[q], units_[0], colours,
+                         demux::minStrengthQ11(p),
+                         demux::RowBlock<std::int16_t>(workRows_, layout_.width),
+                         {strength_, derivativeStrength_}, boundaries_[q]);
   }
   return {};
 }

@@ -703,4 +703,16 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
   }
 }
 
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::detectBoundaries(const Planes3& separated,
+                                          ImageView<const std::uint8_t> order,
+                                          ConstDirectionPlane direction, const UnitTable& units,
+                                          const TileColours& colours, int minStrength,
+                                          const RowBlock<std::int16_t>& ringRows,
+                                          const StrengthPlanes& strengths, BoundaryPlane out) {
+  demux::detectBoundaries(separated, order, direction, units, colours, minStrength, ringRows,
+                          strengths, out);
+}
+#endif
+
 }  // namespace smx::algo::demux

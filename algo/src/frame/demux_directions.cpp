@@ -610,6 +610,15 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
   }
 }
 
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
+                                        const RowBlock<std::int32_t>& rows,
+                                        std::span<std::uint32_t> tileHistograms,
+                                        std::span<std::int32_t> tileMoments) {
+  demux::histogramTiles(smoothed, layout, rows, tileHistograms, tileMoments);
+}
+#endif
+
 void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
                         std::span<const std::int32_t> tileMoments,
                         std::span<const std::uint16_t> predicted, std::span<TileDirection> out,

@@ -20,6 +20,19 @@
 #define SMX_IVDEP
 #endif
 
+// x86-64 with GCC: the vectorised stages also have an AVX2 build. Each twin (AVX2_TWIN) is
+// compiled for AVX2 with the stage's whole body inlined into it (flatten), so the helpers it
+// calls are AVX2 code too, while every out-of-line function stays baseline code (no AVX2 leaks
+// into what the baseline path calls). run() takes the twins where the CPU has AVX2, as OpenCV's
+// dispatch does for the Sobel the speed is measured against. Integer arithmetic: both builds
+// give the same output (DemuxKernels.* compares them).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define SMX_DEMUX_AVX2 1
+#define SMX_AVX2_TWIN [[gnu::target("avx2"), gnu::flatten]]
+#else
+#define SMX_DEMUX_AVX2 0
+#endif
+
 namespace smx::algo::demux {
 
 inline constexpr int kBins = 64;               // doubled-angle histogram bins (2π)
@@ -186,5 +199,30 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
                       const TileColours& colours, int minStrength,
                       const RowBlock<std::int16_t>& ringRows, const StrengthPlanes& strengths,
                       BoundaryPlane out);
+
+// The stages that have twins, as run() calls them.
+struct Kernels {
+  decltype(&smoothChannels) smooth;
+  decltype(&histogramTiles) histogram;
+  decltype(&separate) separation;
+  decltype(&detectBoundaries) boundaries;
+};
+// The baseline build (SSE2 on x86-64, NEON on aarch64).
+[[nodiscard]] const Kernels& baselineKernels();
+// The AVX2 twins where they are built and the CPU runs them; else the baseline.
+[[nodiscard]] const Kernels& fastestKernels();
+
+#if SMX_DEMUX_AVX2
+namespace avx2 {
+using SmoothChannels = decltype(smoothChannels);
+using HistogramTiles = decltype(histogramTiles);
+using Separate = decltype(separate);
+using DetectBoundaries = decltype(detectBoundaries);
+SmoothChannels smoothChannels;
+HistogramTiles histogramTiles;
+Separate separate;
+DetectBoundaries detectBoundaries;
+}  // namespace avx2
+#endif
 
 }  // namespace smx::algo::demux

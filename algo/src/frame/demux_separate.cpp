@@ -516,4 +516,16 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
   }
 }
 
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::separate(
+    const Planes3& smoothed, const DemuxLayout& layout, std::span<const TileDirection> tiles,
+    std::span<const TileInterp> columns, std::span<const TileInterp> rows, const UnitTable& units,
+    const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
+    std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
+    std::span<const ImageView<std::uint8_t>> order) {
+  demux::separate(smoothed, layout, tiles, columns, rows, units, filtered, work, directions,
+                  separated, order);
+}
+#endif
+
 }  // namespace smx::algo::demux

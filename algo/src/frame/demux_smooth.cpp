@@ -112,6 +112,13 @@ void smoothChannels(ConstRgbView image, const Planes3& out, int passes,
   }
 }
 
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::smoothChannels(ConstRgbView image, const Planes3& out, int passes,
+                                        std::span<std::int16_t> rowScratch) {
+  demux::smoothChannels(image, out, passes, rowScratch);
+}
+#endif
+
 namespace {
 
 // Σ of the plane over each tile of one tile row, into tileRow[tx * 3]: per column over the rows

@@ -44,6 +44,7 @@ struct DemuxParams {
   int minContrastGrey = 4;       // and in grey levels per pixel (max − min over the channels)
   int smoothPasses = 1;          // step 1: 3×3 binomial passes (σ 0.7 px; two: σ 1 px)
   bool normaliseColour = true;   // step 4
+  bool avx2 = true;  // x86-64: the kernels' AVX2 build where the CPU has it (same output)
 };
 
 // The frame geometry fixed at init: image size, projector count and each projector's predicted
@@ -71,6 +72,7 @@ struct TileDirection {
 namespace demux {
 class UnitTable;
 struct TileInterp;
+struct Kernels;
 }  // namespace demux
 
 class Demultiplexer {
@@ -109,6 +111,7 @@ class Demultiplexer {
   [[nodiscard]] Result<void> carve(Carver& carver);
 
   DemuxLayout layout_;
+  const demux::Kernels* kernels_ = nullptr;  // the build of the vectorised stages run() calls
   std::span<std::uint16_t> predicted_;
   std::span<demux::UnitTable> units_;  // one table
   std::span<demux::TileInterp> columns_;
