@@ -184,11 +184,12 @@ class Stages {
     kernels_.histogram(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
   }
   void directions() {
-    kern::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
-                             tileScratch_);
+    kernels_.directions(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                        tileScratch_);
   }
   void interpolate() {
-    kern::interpolateDirections(layout_, tileDirections_, columns_, rows_, directionPlanes());
+    kernels_.interpolation(layout_, tileDirections_, columns_, rows_, filterRows_,
+                           directionPlanes());
   }
   void separate() {
     kernels_.separation(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_,

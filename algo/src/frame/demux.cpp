@@ -20,14 +20,16 @@ void UnitTable::fill() {
 }
 
 const Kernels& baselineKernels() {
-  static constexpr Kernels kBaseline{smoothChannels, histogramTiles, separate, detectBoundaries};
+  static constexpr Kernels kBaseline{smoothChannels,        histogramTiles, estimateDirections,
+                                     interpolateDirections, separate,       detectBoundaries};
   return kBaseline;
 }
 
 const Kernels& fastestKernels() {
 #if SMX_DEMUX_AVX2
-  static constexpr Kernels kAvx2{avx2::smoothChannels, avx2::histogramTiles, avx2::separate,
-                                 avx2::detectBoundaries};
+  static constexpr Kernels kAvx2{avx2::smoothChannels,     avx2::histogramTiles,
+                                 avx2::estimateDirections, avx2::interpolateDirections,
+                                 avx2::separate,           avx2::detectBoundaries};
   if (__builtin_cpu_supports("avx2")) {
     return kAvx2;
   }
@@ -166,12 +168,14 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
     kernels_->histogram(smoothed_, layout_,
                         demux::RowBlock<std::int32_t>(filterRows_, layout_.width), tileHistograms_,
                         tileMoments_);
-    demux::estimateDirections(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
-                              tileScratch_);
+    kernels_->directions(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                         tileScratch_);
   }
   const auto projectors = static_cast<std::size_t>(layout_.projectors);
-  demux::interpolateDirections(layout_, tileDirections_, columns_, rows_,
-                               std::span<const DirectionPlane>(directions_.data(), projectors));
+  static_assert(demux::kInterpolationRows <= demux::kFilterRows);
+  kernels_->interpolation(layout_, tileDirections_, columns_, rows_,
+                          demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
+                          std::span<const DirectionPlane>(directions_.data(), projectors));
   // Every projector separated in one sweep (the derivatives are shared), then its boundaries.
   kernels_->separation(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
                        demux::RowBlock<std::int32_t>(filterRows_, layout_.width),

@@ -711,4 +711,15 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
   fillAbsentTiles(layout, predicted, out);
 }
 
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::estimateDirections(const DemuxLayout& layout,
+                                            std::span<const std::uint32_t> tileHistograms,
+                                            std::span<const std::int32_t> tileMoments,
+                                            std::span<const std::uint16_t> predicted,
+                                            std::span<TileDirection> out,
+                                            std::span<std::uint16_t> scratch) {
+  demux::estimateDirections(layout, tileHistograms, tileMoments, predicted, out, scratch);
+}
+#endif
+
 }  // namespace smx::algo::demux

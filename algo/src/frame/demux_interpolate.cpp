@@ -1,5 +1,5 @@
 // Direction planes: each projector's tile angles interpolated bilinearly between tile centres,
-// as wrapped differences from the lower-left tile's angle (int64), per pixel.
+// as wrapped differences from the lower-left tile's angle, per pixel.
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -29,50 +29,87 @@ void tileInterpolation(int pixels, int tilePx, int tiles, std::span<TileInterp> 
   }
 }
 
+namespace {
+
+// A band of rows shares its lower and upper tile rows, so per pixel the bilinear sum
+//   d10·wx·(256 − wy) + (d01·(256 − wx) + d11·wx)·wy + 2^15 = 256·P + wy·(Q − P) + 2^15
+// with P = d10·wx and Q = d01·(256 − wx) + d11·wx (the d's wrapped differences from the
+// lower-left tile's angle a00) changes only with wy. wy·(Q − P) overflows int32; with
+// Q − P = 256·h + l, 0 <= l < 256, the sum >> 16 is (P + wy·h + ((wy·l + 2^15) >> 8)) >> 8
+// exactly (floor division nests), every term within int32.
+enum BandRow : std::size_t { kA00, kP, kH, kL };
+
+void bandLines(const TileDirection* lowerRow, const TileDirection* upperRow, int tilesX,
+               std::span<const TileInterp> columns, const RowBlock<std::int32_t>& band) {
+  std::int32_t* a00 = band.row(kA00);
+  std::int32_t* p = band.row(kP);
+  std::int32_t* h = band.row(kH);
+  std::int32_t* l = band.row(kL);
+  for (std::size_t x = 0; x < columns.size(); ++x) {
+    const TileInterp& cx = columns[x];
+    const auto lo = static_cast<std::size_t>(cx.lower);
+    // Where the weight is 0 (outside the outer tile centres) the upper column does not count.
+    const auto up = static_cast<std::size_t>(cx.lower + 1 < tilesX ? cx.lower + 1 : cx.lower);
+    const std::uint16_t corner = lowerRow[lo].angle;
+    const std::int32_t d10 = wrapDiff(lowerRow[up].angle, corner);
+    const std::int32_t d01 = wrapDiff(upperRow[lo].angle, corner);
+    const std::int32_t d11 = wrapDiff(upperRow[up].angle, corner);
+    const std::int32_t wx = cx.weight;
+    const std::int32_t lowerLine = d10 * wx;                     // |P| < 2^23
+    const std::int32_t upperLine = d01 * (256 - wx) + d11 * wx;  // |Q| < 2^23
+    const std::int32_t diff = upperLine - lowerLine;
+    a00[x] = corner;
+    p[x] = lowerLine;
+    h[x] = diff >> 8;
+    l[x] = diff & 255;
+  }
+}
+
+}  // namespace
+
 void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+                           const RowBlock<std::int32_t>& band,
                            std::span<const DirectionPlane> out) {
   const int tilesX = layout.tilesX();
   const std::size_t tileCount = layout.tileCount();
   const int w = layout.width;
-  for (int p = 0; p < layout.projectors; ++p) {
-    const TileDirection* mine = tiles.data() + static_cast<std::size_t>(p) * tileCount;
+  const std::int32_t* a00 = band.row(kA00);
+  const std::int32_t* p = band.row(kP);
+  const std::int32_t* h = band.row(kH);
+  const std::int32_t* l = band.row(kL);
+  for (int q = 0; q < layout.projectors; ++q) {
+    const TileDirection* mine = tiles.data() + static_cast<std::size_t>(q) * tileCount;
+    int lower = -1;
+    int upper = -1;
     for (int y = 0; y < layout.height; ++y) {
       const TileInterp& ry = rows[static_cast<std::size_t>(y)];
+      if (ry.lower != lower || ry.upper != upper) {
+        lower = ry.lower;
+        upper = ry.upper;
+        bandLines(mine + static_cast<std::size_t>(lower) * static_cast<std::size_t>(tilesX),
+                  mine + static_cast<std::size_t>(upper) * static_cast<std::size_t>(tilesX), tilesX,
+                  columns, band);
+      }
       const std::int32_t wy = ry.weight;
-      const TileDirection* lowerRow =
-          mine + static_cast<std::size_t>(ry.lower) * static_cast<std::size_t>(tilesX);
-      const TileDirection* upperRow =
-          mine + static_cast<std::size_t>(ry.upper) * static_cast<std::size_t>(tilesX);
-      std::uint16_t* dst = out[static_cast<std::size_t>(p)].rowPtr(y);
-      // Between two tile centres the four corners are fixed, and the bilinear sum
-      //   d10·wx·(256 − wy) + d01·(256 − wx)·wy + d11·wx·wy + 2^15 = wx·slope + 256·base
-      // is one multiply-add per pixel. Where the weight is 0 (outside the outer tile centres)
-      // the upper column does not count, so the corners change only with the lower column.
-      int lower = -1;
-      std::uint16_t a00 = 0;
-      std::int32_t slope = 0;
-      std::int32_t base = 0;
+      std::uint16_t* dst = out[static_cast<std::size_t>(q)].rowPtr(y);
       for (int x = 0; x < w; ++x) {
-        const TileInterp& cx = columns[static_cast<std::size_t>(x)];
-        if (cx.lower != lower) {
-          lower = cx.lower;
-          const auto l = static_cast<std::size_t>(lower);
-          const auto u = static_cast<std::size_t>(lower + 1 < tilesX ? lower + 1 : lower);
-          a00 = lowerRow[l].angle;
-          const std::int32_t d10 = wrapDiff(lowerRow[u].angle, a00);
-          const std::int32_t d01 = wrapDiff(upperRow[l].angle, a00);
-          const std::int32_t d11 = wrapDiff(upperRow[u].angle, a00);
-          slope = d10 * (256 - wy) + (d11 - d01) * wy;  // |slope| < 2^25
-          base = d01 * wy + 128;                        // |base| < 2^23
-        }
-        // wx·slope + 256·base overflows int32; in int64 it is one scalar multiply-add.
-        const std::int64_t sum = std::int64_t{cx.weight} * slope + std::int64_t{base} * 256;
-        const auto delta = static_cast<std::int32_t>(sum >> 16);
-        dst[x] = static_cast<std::uint16_t>(a00 + static_cast<std::uint16_t>(delta));
+        const std::int32_t delta = (p[x] + wy * h[x] + ((wy * l[x] + 32768) >> 8)) >> 8;
+        dst[x] = static_cast<std::uint16_t>(a00[x] + delta);
       }
     }
   }
 }
+
+#if SMX_DEMUX_AVX2
+SMX_AVX2_TWIN void avx2::interpolateDirections(const DemuxLayout& layout,
+                                               std::span<const TileDirection> tiles,
+                                               std::span<const TileInterp> columns,
+                                               std::span<const TileInterp> rows,
+                                               const RowBlock<std::int32_t>& band,
+                                               std::span<const DirectionPlane> out) {
+  demux::interpolateDirections(layout, tiles, columns, rows, band, out);
+}
+#endif
 
 }  // namespace smx::algo::demux

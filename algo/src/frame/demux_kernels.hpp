@@ -147,10 +147,13 @@ inline constexpr std::size_t kWorkRows = 33;
 }
 
 // Every projector's direction plane: its tile angles interpolated bilinearly between tile
-// centres (as wrapped differences, int64).
+// centres (as wrapped differences from the lower-left tile's). band: kInterpolationRows working
+// rows of the image's width (run() lends separate()'s filter rows), the per-pixel terms shared
+// by a band of rows between two tile rows' centres.
+inline constexpr std::size_t kInterpolationRows = 4;
 void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-                           std::span<const DirectionPlane> out);
+                           const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out);
 
 // Stage 3 for every projector in one sweep: per projector, the separated derivative per channel
 // (D, 32 × grey level per pixel for the first order) and the derivative order per pixel (1 or
@@ -204,6 +207,8 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
 struct Kernels {
   decltype(&smoothChannels) smooth;
   decltype(&histogramTiles) histogram;
+  decltype(&estimateDirections) directions;
+  decltype(&interpolateDirections) interpolation;
   decltype(&separate) separation;
   decltype(&detectBoundaries) boundaries;
 };
@@ -216,10 +221,14 @@ struct Kernels {
 namespace avx2 {
 using SmoothChannels = decltype(smoothChannels);
 using HistogramTiles = decltype(histogramTiles);
+using EstimateDirections = decltype(estimateDirections);
+using InterpolateDirections = decltype(interpolateDirections);
 using Separate = decltype(separate);
 using DetectBoundaries = decltype(detectBoundaries);
 SmoothChannels smoothChannels;
 HistogramTiles histogramTiles;
+EstimateDirections estimateDirections;
+InterpolateDirections interpolateDirections;
 Separate separate;
 DetectBoundaries detectBoundaries;
 }  // namespace avx2
