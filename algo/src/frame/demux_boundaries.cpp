@@ -515,10 +515,33 @@ struct Candidate {
   std::int32_t behind;
 };
 
-// The boundary at a candidate maximum (x, y) of strength s0, or none when it is a side lobe.
-Boundary boundaryAt(const InverseRow& inverse, const StrengthPlanes& strengths, std::uint8_t order,
-                    std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
-                    const Candidate& c) {
+// The relative values at pixel x of row y, which the strength pass kept in the ring.
+Response relativeValuesAt(const SampleRing& ring, int y, int x) {
+  Response r{};
+  for (int channel = 0; channel < 3; ++channel) {
+    r.n[channel] = *ring.relative(y, channel, x);
+  }
+  return r;
+}
+
+// The boundary at a first-order candidate maximum of strength s0: the class from the relative
+// values, the position from the derivative strength (`behind`, `centre`, `ahead` at −1, 0,
+// +1 px): the relative strength's samples have each their own divisor (whose gradient is
+// steepest where the surface colour changes), and dividing by a dark channel's average scales
+// its noise up with its signal. Where that parabola has no maximum, the relative strength's.
+Boundary firstOrderBoundary(const Response& hereValues, std::int32_t s0, const Candidate& c,
+                            std::int32_t behind, std::int32_t centre, std::int32_t ahead) {
+  Boundary found = classify(hereValues);
+  const auto v = vertexQ8(behind, centre, ahead);
+  const std::int32_t offset = v ? *v : vertexQ8(c.behind, s0, c.ahead).value_or(0);
+  found.offset = static_cast<std::int16_t>(std::clamp(offset, -128, 128));
+  return found;
+}
+
+// The boundary at a second-order candidate maximum (x, y), or none when it is a side lobe.
+Boundary secondOrderBoundary(const InverseRow& inverse, const StrengthPlanes& strengths,
+                             std::int32_t ux, std::int32_t uy, const SampleRing& ring, int y,
+                             const Candidate& c) {
   const int x = c.x;
   const ImageView<const std::uint16_t> st = strengths.relative;
   const int w = st.width();
@@ -527,47 +550,26 @@ Boundary boundaryAt(const InverseRow& inverse, const StrengthPlanes& strengths, 
   const std::int32_t s0 = *here;
   // A second-order response has side lobes of about half the peak two pixels out, with the
   // reversed class: such a maximum must also beat the samples two pixels away.
-  if (order == 2 && y >= kMargin + 2 && y < h - kMargin - 2 && x >= kMargin + 2 &&
-      x < w - kMargin - 2) {
+  if (y >= kMargin + 2 && y < h - kMargin - 2 && x >= kMargin + 2 && x < w - kMargin - 2) {
     const std::ptrdiff_t stride = strideOf(st);
     const TapPair far = tapsAlong(ux, uy, 5);
     if (s0 < sampleAt(here, stride, far.ahead) || s0 <= sampleAt(here, stride, far.behind)) {
       return {};
     }
   }
-  // Where a finer estimate does not apply: the vertex through the strength plane's samples.
-  const auto strengthVertex = [&] { return vertexQ8(c.behind, s0, c.ahead).value_or(0); };
-  std::int32_t offset = 0;
-  Boundary found;
-  Response hereValues{};
+  Response behindSamples{};
+  Response aheadSamples{};
   for (int channel = 0; channel < 3; ++channel) {
-    hereValues.n[channel] = *ring.relative(y, channel, x);
+    const auto k = static_cast<std::size_t>(channel);
+    behindSamples.n[k] = *ring.at(y, channel, x);
+    aheadSamples.n[k] = *ring.at(y, 3 + channel, x);
   }
-  if (order == 1) {
-    found = classify(hereValues);
-    // The position from the derivative itself: the strength plane's samples have each their
-    // own divisor (whose gradient is steepest where the surface colour changes), and dividing
-    // by a dark channel's average scales its noise up with its signal.
-    const TapPair near = tapsAlong(ux, uy, 6);
-    const std::uint16_t* derivative = strengths.derivative.rowPtr(y) + x;
-    const std::ptrdiff_t stride = strideOf(strengths.derivative);
-    const auto v = vertexQ8(sampleAt(derivative, stride, near.behind), *derivative,
-                            sampleAt(derivative, stride, near.ahead));
-    offset = v ? *v : strengthVertex();
-  } else {
-    Response behindSamples{};
-    Response aheadSamples{};
-    for (int channel = 0; channel < 3; ++channel) {
-      const auto k = static_cast<std::size_t>(channel);
-      behindSamples.n[k] = *ring.at(y, channel, x);
-      aheadSamples.n[k] = *ring.at(y, 3 + channel, x);
-    }
-    behindSamples = relativeAt(inverse, behindSamples, x);
-    aheadSamples = relativeAt(inverse, aheadSamples, x);
-    found = classify(secondOrderResponse(behindSamples, aheadSamples));
-    const auto z = zeroCrossingQ8(found, behindSamples, hereValues, aheadSamples);
-    offset = z ? *z : strengthVertex();
-  }
+  behindSamples = relativeAt(inverse, behindSamples, x);
+  aheadSamples = relativeAt(inverse, aheadSamples, x);
+  Boundary found = classify(secondOrderResponse(behindSamples, aheadSamples));
+  const auto z = zeroCrossingQ8(found, behindSamples, relativeValuesAt(ring, y, x), aheadSamples);
+  // Where it does not cross zero there: the vertex through the strength plane's samples.
+  const std::int32_t offset = z ? *z : vertexQ8(c.behind, s0, c.ahead).value_or(0);
   found.offset = static_cast<std::int16_t>(std::clamp(offset, -128, 128));
   return found;
 }
@@ -585,7 +587,9 @@ std::uint64_t withoutByte(std::uint64_t word, int byte) {
 
 // Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
 // (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
-// the strength), then the costly rest on the maxima only, found eight flags at a time.
+// the strength), then the costly rest on the maxima only, found eight flags at a time. A
+// first-order maximum's derivative samples take the chunk's taps (the same ±1 px along the
+// encoding direction).
 void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, const std::uint8_t* o,
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
@@ -602,6 +606,8 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
                                          static_cast<int>(s0 >= samples.ahead[i]) &
                                          static_cast<int>(s0 > samples.behind[i]));
   }
+  const std::uint16_t* derivative = strengths.derivative.rowPtr(y) + x0;
+  const std::ptrdiff_t stride = strideOf(strengths.derivative);
   for (int i8 = 0; i8 < n; i8 += 8) {
     std::uint64_t flags = 0;
     std::memcpy(&flags, isMax + i8, sizeof flags);
@@ -610,8 +616,18 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
       flags = withoutByte(flags, byte);
       const int i = i8 + byte;
       const int x = x0 + i;
-      b[x] = boundaryAt(inverse, strengths, o[x], unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
-                        ring, y, {x, samples.ahead[i], samples.behind[i]});
+      const Candidate c{x, samples.ahead[i], samples.behind[i]};
+      if (o[x] == 1) {
+        const RunOffsets at = offsetsOf(taps.offsets[i]);
+        const std::uint16_t* behind = cornerOf(derivative, stride, at.behindDx, at.behindDy);
+        const std::uint16_t* ahead = cornerOf(derivative, stride, at.aheadDx, at.aheadDy);
+        b[x] = firstOrderBoundary(relativeValuesAt(ring, y, x), s[i], c,
+                                  bilinear(behind, behind + stride, taps.behind, i), derivative[i],
+                                  bilinear(ahead, ahead + stride, taps.ahead, i));
+      } else {
+        b[x] = secondOrderBoundary(inverse, strengths, unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
+                                   ring, y, c);
+      }
     }
   }
 }
