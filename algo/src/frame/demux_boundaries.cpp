@@ -624,7 +624,7 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
         b[x] = firstOrderBoundary(relativeValuesAt(ring, y, x), s[i], c,
                                   bilinear(behind, behind + stride, taps.behind, i), derivative[i],
                                   bilinear(ahead, ahead + stride, taps.ahead, i));
-      } else {
+      } else {  // order 2 (a pixel of order 0 has strength 0: never a maximum)
         b[x] = secondOrderBoundary(inverse, strengths, unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
                                    ring, y, c);
       }

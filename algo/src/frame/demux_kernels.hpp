@@ -20,7 +20,7 @@
 #define SMX_IVDEP
 #endif
 
-// x86-64 with GCC: the vectorised stages also have an AVX2 build. Each twin (AVX2_TWIN) is
+// x86-64 with GCC: the vectorised stages also have an AVX2 build. Each twin (SMX_AVX2_TWIN) is
 // compiled for AVX2 with the stage's whole body inlined into it (flatten), so the helpers it
 // calls are AVX2 code too, while every out-of-line function stays baseline code (no AVX2 leaks
 // into what the baseline path calls). run() takes the twins where the CPU has AVX2, as OpenCV's
