@@ -20,25 +20,22 @@ namespace {
 
 using test::SyntheticPattern;
 
-// A demultiplexer over its own memory, with the AVX2 build allowed or not.
+// A demultiplexer over its own memory.
 struct OwnedDemux {
   std::vector<std::byte> memory;
   Arena arena;
   Demultiplexer demux;
 
-  OwnedDemux(DemuxLayout layout, bool avx2, const std::vector<std::uint16_t>& predicted)
-      : memory(workspaceFor(layout, avx2)), arena(memory), demux(create(layout, avx2, predicted)) {}
-
- private:
-  static std::size_t workspaceFor(DemuxLayout layout, bool avx2) {
-    layout.params.avx2 = avx2;
-    return *Demultiplexer::workspaceBytes(layout);
-  }
-  Demultiplexer create(DemuxLayout layout, bool avx2, const std::vector<std::uint16_t>& predicted) {
-    layout.params.avx2 = avx2;
-    return *Demultiplexer::create(layout, predicted, arena);
-  }
+  OwnedDemux(const DemuxLayout& layout, const std::vector<std::uint16_t>& predicted)
+      : memory(*Demultiplexer::workspaceBytes(layout)),
+        arena(memory),
+        demux(*Demultiplexer::create(layout, predicted, arena)) {}
 };
+
+DemuxLayout withAvx2(DemuxLayout layout, bool avx2) {
+  layout.params.avx2 = avx2;
+  return layout;
+}
 
 template <class T>
 bool sameRows(ImageView<const T> a, ImageView<const T> b) {
@@ -95,8 +92,8 @@ TEST_P(DemuxKernels, TheAvx2BuildGivesTheBaselineOutput) {
   }
   const auto image = noisyFrame(patterns, kW, kH);
   const auto view = *ConstRgbView::packed(image, kW, kH);
-  OwnedDemux fast(layout, true, predicted);
-  OwnedDemux baseline(layout, false, predicted);
+  OwnedDemux fast(withAvx2(layout, true), predicted);
+  OwnedDemux baseline(withAvx2(layout, false), predicted);
   ASSERT_TRUE(fast.demux.run(view).has_value());
   ASSERT_TRUE(baseline.demux.run(view).has_value());
 
