@@ -216,14 +216,15 @@ namespace {
 constexpr int kMargin = 3;     // responses and their neighbours stay inside the separated area
 constexpr int kChunkPx = 128;  // pixels per chunk of a row: taps, samples and maxima on the stack
 
-// The taps one pixel behind and ahead along the encoding direction for a chunk of a row, as
-// plain rows: per pixel the bilinear weights (256 − f, f) in x and y, and a code of the four
-// integer offsets. The direction field is smooth, so the code is constant over long runs, and
-// within a run every sample is shifted-row arithmetic that vectorises without gathers.
+// The second-order samples' taps one pixel behind and ahead along the encoding direction for a
+// chunk of a row, as plain rows: per pixel the bilinear fractions in x and y, and a code of the
+// four integer offsets. The direction field is smooth, so the code is constant over runs, and
+// within a run every sample is shifted-row arithmetic in int16 lanes. (The tents below take
+// the same arithmetic for every pixel, but blend16's rounding depends on which two values it
+// blends: selecting them per pixel cost 15 % of the 3-projector stage.)
 struct TapWeights {
-  std::int16_t x0[kChunkPx];
   std::int16_t x1[kChunkPx];
-  std::int16_t y1[kChunkPx];  // the y weights are 256 − y1 and y1
+  std::int16_t y1[kChunkPx];
 };
 
 struct ChunkTaps {
@@ -267,6 +268,12 @@ class UnitsQ8 {
     }
   }
   [[nodiscard]] std::uint32_t operator[](std::uint16_t entry) const { return q8_[entry]; }
+  // The entry nearest a direction (BinAngle raw). 16-bit wrap-around: the carry out of the sum
+  // is masked off by the entry count anyway.
+  [[nodiscard]] static std::uint16_t entryOf(std::uint16_t direction) {
+    const auto rounded = static_cast<std::uint16_t>(direction + 32U);
+    return static_cast<std::uint16_t>((rounded >> 6U) & (kEntries - 1U));
+  }
 
  private:
   std::array<std::uint32_t, kEntries> q8_{};
@@ -275,15 +282,9 @@ class UnitsQ8 {
 // The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: UnitTable's entries (rounded to the
 // nearest) and the arithmetic in loops that vectorise around the one gather.
 void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t) {
-  std::uint16_t entry[kChunkPx];
-  for (int i = 0; i < n; ++i) {
-    // 16-bit wrap-around: the carry out of the sum is masked off by the entry count anyway.
-    const auto rounded = static_cast<std::uint16_t>(d[i] + 32U);
-    entry[i] = static_cast<std::uint16_t>((rounded >> 6U) & (UnitsQ8::kEntries - 1U));
-  }
   std::uint32_t unit[kChunkPx];
   for (int i = 0; i < n; ++i) {
-    unit[i] = units[entry[i]];
+    unit[i] = units[UnitsQ8::entryOf(d[i])];
   }
   for (int i = 0; i < n; ++i) {
     const auto ax = static_cast<std::int16_t>(unit[i]);
@@ -292,8 +293,6 @@ void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t
     t.ahead.y1[i] = static_cast<std::int16_t>(ay & 255);
     t.behind.x1[i] = static_cast<std::int16_t>(-ax & 255);
     t.behind.y1[i] = static_cast<std::int16_t>(-ay & 255);
-    t.ahead.x0[i] = static_cast<std::int16_t>(256 - t.ahead.x1[i]);
-    t.behind.x0[i] = static_cast<std::int16_t>(256 - t.behind.x1[i]);
     t.offsets[i] =
         offsetCode(static_cast<std::int16_t>(-ax), static_cast<std::int16_t>(-ay), ax, ay);
   }
@@ -323,28 +322,76 @@ void forEachRun(const ChunkTaps& t, int n, F&& f) {
   }
 }
 
-// sampleAt's arithmetic for pixel i of a run: r0 points at the 2×2 corner of pixel 0, r1 one
-// row below.
-template <class T>
-std::int32_t bilinear(const T* r0, const T* r1, const TapWeights& t, int i) {
-  // The weights in T: products of two same-signed 16-bit values widen in one vector step.
-  const auto x0 = static_cast<T>(t.x0[i]);
-  const auto x1 = static_cast<T>(t.x1[i]);
-  const std::int32_t top = r0[i] * x0 + r0[i + 1] * x1;
-  const std::int32_t bottom = r1[i] * x0 + r1[i + 1] * x1;
-  // top · (256 − y1) + bottom · y1 with one 32-bit product
-  return ((top << 8) + (bottom - top) * t.y1[i] + 32768) >> 16;
-}
-
 template <class T>
 const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
   return pixel0 + static_cast<std::ptrdiff_t>(dy) * stride + dx;
 }
 
+// The bilinear samples one pixel ahead and behind along the encoding direction, for a chunk. A
+// sample at a Q8 offset u in [−256, 256] along one axis is the tent over the columns −1, 0, +1
+// with weights max(−u, 0), 256 − |u|, max(u, 0): the bilinear blend of the two columns around
+// it whatever the sign of u, which is 256·v(0) + u·(v(1) − v(0)) for u > 0 and 256·v(0) +
+// u·(v(0) − v(−1)) otherwise (the sample behind, at −u, takes the other difference). So every
+// pixel takes the same arithmetic and the loops vectorise over whole chunks, where the 2×2
+// corners' offsets split chunks into runs wherever a component of the direction changes sign.
+// The sums are those of the bilinear blend's, exact in uint32 arithmetic: a sample is at most
+// 65535 · 2^16 + 2^15 < 2^32 before the shift, so wrapping differences cancel.
+struct ChunkTents {
+  std::int16_t ux[kChunkPx];  // the unit vector in Q8: [−256, 256]
+  std::int16_t uy[kChunkPx];
+};
+
+void chunkTents(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTents& t) {
+  std::uint32_t unit[kChunkPx];
+  for (int i = 0; i < n; ++i) {
+    unit[i] = units[UnitsQ8::entryOf(d[i])];
+  }
+  for (int i = 0; i < n; ++i) {
+    t.ux[i] = static_cast<std::int16_t>(unit[i]);
+    t.uy[i] = static_cast<std::int16_t>(unit[i] >> 16U);
+  }
+}
+
+struct TentRows {
+  const std::uint16_t* above;
+  const std::uint16_t* at;
+  const std::uint16_t* below;
+};
+
+TentRows tentRows(const std::uint16_t* pixel0, std::ptrdiff_t stride) {
+  return {pixel0 - stride, pixel0, pixel0 + stride};
+}
+
+struct TentPair {
+  std::uint32_t ahead;  // 256 × the horizontal blend, or 2^16 × the bilinear sample
+  std::uint32_t behind;
+};
+
+// The blends at ±u along one axis from the values at −1, 0, +1.
+TentPair tentBlend(std::uint32_t minus, std::uint32_t centre, std::uint32_t plus, std::int32_t u) {
+  const std::uint32_t forward = plus - centre;
+  const std::uint32_t backward = centre - minus;
+  const auto su = static_cast<std::uint32_t>(u);
+  return {(centre << 8U) + su * (u > 0 ? forward : backward),
+          (centre << 8U) - su * (u > 0 ? backward : forward)};
+}
+
+// The samples ahead and behind of pixel i of the chunk, rounded half up.
+TentPair tentSamples(const TentRows& r, const ChunkTents& t, int i) {
+  const std::int32_t ux = t.ux[i];
+  const TentPair above = tentBlend(r.above[i - 1], r.above[i], r.above[i + 1], ux);
+  const TentPair at = tentBlend(r.at[i - 1], r.at[i], r.at[i + 1], ux);
+  const TentPair below = tentBlend(r.below[i - 1], r.below[i], r.below[i + 1], ux);
+  const std::int32_t uy = t.uy[i];
+  const std::uint32_t ahead = tentBlend(above.ahead, at.ahead, below.ahead, uy).ahead;
+  const std::uint32_t behind = tentBlend(above.behind, at.behind, below.behind, uy).behind;
+  return {(ahead + 32768U) >> 16U, (behind + 32768U) >> 16U};
+}
+
 // (a·(256 − f) + b·f) / 256 for int16 a, b with |b − a| < 2^15 and f in [0, 255], in int16
 // lanes: the product's high half (b − a)·(128·f) >> 16 is a native int16 vector multiply (SSE2
-// pmulhw), where bilinear()'s int32 products are emulated. Rounded down to even units: under 2
-// units of D (1/16 grey level per pixel) low, the same for every sample.
+// pmulhw), where int32 products are emulated. Rounded down to even units: under 2 units of D
+// (1/16 grey level per pixel) low, the same for every sample.
 std::int16_t blend16(std::int16_t a, std::int16_t b, std::int16_t f) {
   const auto diff = static_cast<std::int16_t>(b - a);
   const auto f128 = static_cast<std::int16_t>(f << 7);
@@ -493,18 +540,12 @@ struct ChunkSamples {
   std::int32_t behind[kChunkPx];
 };
 
-void strengthSamples(const std::uint16_t* pixel0, std::ptrdiff_t stride, const ChunkTaps& t, int n,
-                     ChunkSamples& out) {
-  forEachRun(t, n, [&](int i0, int i1, const RunOffsets& o) {
-    const std::uint16_t* b0 = cornerOf(pixel0, stride, o.behindDx, o.behindDy);
-    const std::uint16_t* b1 = b0 + stride;
-    const std::uint16_t* a0 = cornerOf(pixel0, stride, o.aheadDx, o.aheadDy);
-    const std::uint16_t* a1 = a0 + stride;
-    for (int i = i0; i < i1; ++i) {
-      out.ahead[i] = bilinear(a0, a1, t.ahead, i);
-      out.behind[i] = bilinear(b0, b1, t.behind, i);
-    }
-  });
+void strengthSamples(const TentRows& rows, const ChunkTents& t, int n, ChunkSamples& out) {
+  for (int i = 0; i < n; ++i) {
+    const TentPair pair = tentSamples(rows, t, i);
+    out.ahead[i] = static_cast<std::int32_t>(pair.ahead);
+    out.behind[i] = static_cast<std::int32_t>(pair.behind);
+  }
 }
 
 // Where the strength at x is at least the minimum and no less than the bilinear sample one pixel
@@ -588,17 +629,17 @@ std::uint64_t withoutByte(std::uint64_t word, int byte) {
 // Non-maximum suppression of one row chunk [x0, x0 + n): every pixel's test runs branch-free
 // (whether a pixel is a maximum is unpredictable; the samples are inside the plane whatever
 // the strength), then the costly rest on the maxima only, found eight flags at a time. A
-// first-order maximum's derivative samples take the chunk's taps (the same ±1 px along the
-// encoding direction).
+// first-order maximum's derivative samples take the chunk's unit vectors (Q8, the same ±1 px
+// along the encoding direction).
 void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, const std::uint8_t* o,
                  const std::uint16_t* d, const UnitsQ8& units, const UnitTable& unitTable,
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
   const ImageView<const std::uint16_t> st = strengths.relative;
   const std::uint16_t* s = st.rowPtr(y) + x0;
-  ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
-  chunkTaps(d + x0, units, n, taps);
+  ChunkTents tents;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTents() fills it
+  chunkTents(d + x0, units, n, tents);
   ChunkSamples samples;  // NOLINT(cppcoreguidelines-pro-type-member-init): filled next
-  strengthSamples(s, strideOf(st), taps, n, samples);
+  strengthSamples(tentRows(s, strideOf(st)), tents, n, samples);
   alignas(8) std::uint8_t isMax[kChunkPx] = {};
   for (int i = 0; i < n; ++i) {
     const std::int32_t s0 = s[i];
@@ -607,7 +648,7 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
                                          static_cast<int>(s0 > samples.behind[i]));
   }
   const std::uint16_t* derivative = strengths.derivative.rowPtr(y) + x0;
-  const std::ptrdiff_t stride = strideOf(strengths.derivative);
+  const std::ptrdiff_t derivativeStride = strideOf(strengths.derivative);
   for (int i8 = 0; i8 < n; i8 += 8) {
     std::uint64_t flags = 0;
     std::memcpy(&flags, isMax + i8, sizeof flags);
@@ -618,12 +659,12 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
       const int x = x0 + i;
       const Candidate c{x, samples.ahead[i], samples.behind[i]};
       if (o[x] == 1) {
-        const RunOffsets at = offsetsOf(taps.offsets[i]);
-        const std::uint16_t* behind = cornerOf(derivative, stride, at.behindDx, at.behindDy);
-        const std::uint16_t* ahead = cornerOf(derivative, stride, at.aheadDx, at.aheadDy);
+        const std::uint16_t* pixel = derivative + i;
+        const std::int32_t ux = tents.ux[i];
+        const std::int32_t uy = tents.uy[i];
         b[x] = firstOrderBoundary(relativeValuesAt(ring, y, x), s[i], c,
-                                  bilinear(behind, behind + stride, taps.behind, i), derivative[i],
-                                  bilinear(ahead, ahead + stride, taps.ahead, i));
+                                  sampleAt(pixel, derivativeStride, tapQ8(-ux, -uy)), *pixel,
+                                  sampleAt(pixel, derivativeStride, tapQ8(ux, uy)));
       } else {  // order 2 (a pixel of order 0 has strength 0: never a maximum)
         b[x] = secondOrderBoundary(inverse, strengths, unitTable.cosOf(d[x]), unitTable.sinOf(d[x]),
                                    ring, y, c);
