@@ -156,26 +156,42 @@ std::uint16_t spread(std::int16_t a, std::int16_t b, std::int16_t c) {
   return static_cast<std::uint16_t>(std::max({a, b, c}) - std::min({a, b, c}));
 }
 
-Boundary classify(const Response& r) {
-  int to = 0;
-  int from = 0;
-  for (int c = 1; c < 3; ++c) {
-    to = r.n[c] > r.n[to] ? c : to;
-    from = r.n[c] < r.n[from] ? c : from;
+// The transition code (Boundary::code) from the falling channel f to the rising one t, at
+// 3·f + t (f = t: none).
+constexpr auto kTransitionCodes = [] {
+  std::array<std::uint8_t, 9> codes{};
+  for (int f = 0; f < 3; ++f) {
+    for (int t = 0; t < 3; ++t) {
+      codes[static_cast<std::size_t>(3 * f + t)] =
+          f == t ? std::uint8_t{0}
+                 : Boundary::code(stripe::transitionBetween(stripe::colourFromIndex(f),
+                                                            stripe::colourFromIndex(t)));
+    }
   }
-  const std::int32_t range = r.n[to] - r.n[from];
-  Boundary b;
-  b.transition = Boundary::code(
-      stripe::transitionBetween(stripe::colourFromIndex(from), stripe::colourFromIndex(to)));
+  return codes;
+}();
+
+// The rising channel is the first largest, the falling one the first smallest; the third
+// channel's value is the median (the sum less the largest and the smallest).
+Boundary classify(const Response& r) {
+  const std::int32_t a = r.n[0];
+  const std::int32_t b = r.n[1];
+  const std::int32_t c = r.n[2];
+  const int to = b > a ? (c > b ? 2 : 1) : (c > a ? 2 : 0);
+  const int from = b < a ? (c < b ? 2 : 1) : (c < a ? 2 : 0);
+  const std::int32_t high = std::max({a, b, c});
+  const std::int32_t low = std::min({a, b, c});
+  const std::int32_t range = high - low;
+  Boundary found;
+  found.transition = kTransitionCodes[static_cast<std::size_t>(3 * from + to)];
   std::int32_t conf = 0;
-  if (to != from) {  // not all equal: range > 0, and the third channel is the remaining one
-    const int third = 3 - to - from;
-    std::int32_t dev = 2 * r.n[third] - r.n[to] - r.n[from];
+  if (range > 0) {  // not all equal: the third channel is the remaining one
+    std::int32_t dev = 2 * (a + b + c - high - low) - high - low;
     dev = dev < 0 ? -dev : dev;
     conf = (255 * (range - dev)) / range;
   }
-  b.confidence = static_cast<std::uint8_t>(conf < 0 ? 0 : (conf > 255 ? 255 : conf));
-  return b;
+  found.confidence = static_cast<std::uint8_t>(conf < 0 ? 0 : (conf > 255 ? 255 : conf));
+  return found;
 }
 
 // Second order: the boundary is where the second derivative, read as (to − from) channel,
