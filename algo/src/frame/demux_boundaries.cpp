@@ -162,7 +162,7 @@ constexpr auto kTransitionCodes = [] {
   std::array<std::uint8_t, 9> codes{};
   for (int f = 0; f < 3; ++f) {
     for (int t = 0; t < 3; ++t) {
-      codes[static_cast<std::size_t>(3 * f + t)] =
+      codes[static_cast<std::size_t>(f) * 3 + static_cast<std::size_t>(t)] =
           f == t ? std::uint8_t{0}
                  : Boundary::code(stripe::transitionBetween(stripe::colourFromIndex(f),
                                                             stripe::colourFromIndex(t)));
@@ -183,7 +183,8 @@ Boundary classify(const Response& r) {
   const std::int32_t low = std::min({a, b, c});
   const std::int32_t range = high - low;
   Boundary found;
-  found.transition = kTransitionCodes[static_cast<std::size_t>(3 * from + to)];
+  found.transition =
+      kTransitionCodes[static_cast<std::size_t>(from) * 3 + static_cast<std::size_t>(to)];
   std::int32_t conf = 0;
   if (range > 0) {  // not all equal: the third channel is the remaining one
     std::int32_t dev = 2 * (a + b + c - high - low) - high - low;
