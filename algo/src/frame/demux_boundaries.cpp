@@ -296,16 +296,29 @@ class UnitsQ8 {
   std::array<std::uint32_t, kEntries> q8_{};
 };
 
-// The ±1 px taps (tapsAlong(…, 6)) of the n pixels from d: UnitTable's entries (rounded to the
-// nearest) and the arithmetic in loops that vectorise around the one gather.
-void chunkTaps(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTaps& t) {
+// The unit vectors (Q8) of a chunk's n pixels from the direction row d: UnitTable's entries,
+// rounded to the nearest, by one gather.
+struct ChunkUnits {
+  std::int16_t ux[kChunkPx];  // [−256, 256]
+  std::int16_t uy[kChunkPx];
+};
+
+void chunkUnits(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkUnits& u) {
   std::uint32_t unit[kChunkPx];
   for (int i = 0; i < n; ++i) {
     unit[i] = units[UnitsQ8::entryOf(d[i])];
   }
   for (int i = 0; i < n; ++i) {
-    const auto ax = static_cast<std::int16_t>(unit[i]);
-    const auto ay = static_cast<std::int16_t>(unit[i] >> 16U);
+    u.ux[i] = static_cast<std::int16_t>(unit[i]);
+    u.uy[i] = static_cast<std::int16_t>(unit[i] >> 16U);
+  }
+}
+
+// The ±1 px taps (tapsAlong(…, 6)) of the chunk's pixels, in loops that vectorise.
+void chunkTaps(const ChunkUnits& u, int n, ChunkTaps& t) {
+  for (int i = 0; i < n; ++i) {
+    const std::int16_t ax = u.ux[i];
+    const std::int16_t ay = u.uy[i];
     t.ahead.x1[i] = static_cast<std::int16_t>(ax & 255);
     t.ahead.y1[i] = static_cast<std::int16_t>(ay & 255);
     t.behind.x1[i] = static_cast<std::int16_t>(-ax & 255);
@@ -353,22 +366,6 @@ const T* cornerOf(const T* pixel0, std::ptrdiff_t stride, int dx, int dy) {
 // corners' offsets split chunks into runs wherever a component of the direction changes sign.
 // The sums are those of the bilinear blend's, exact in uint32 arithmetic: a sample is at most
 // 65535 · 2^16 + 2^15 < 2^32 before the shift, so wrapping differences cancel.
-struct ChunkTents {
-  std::int16_t ux[kChunkPx];  // the unit vector in Q8: [−256, 256]
-  std::int16_t uy[kChunkPx];
-};
-
-void chunkTents(const std::uint16_t* d, const UnitsQ8& units, int n, ChunkTents& t) {
-  std::uint32_t unit[kChunkPx];
-  for (int i = 0; i < n; ++i) {
-    unit[i] = units[UnitsQ8::entryOf(d[i])];
-  }
-  for (int i = 0; i < n; ++i) {
-    t.ux[i] = static_cast<std::int16_t>(unit[i]);
-    t.uy[i] = static_cast<std::int16_t>(unit[i] >> 16U);
-  }
-}
-
 struct TentRows {
   const std::uint16_t* above;
   const std::uint16_t* at;
@@ -394,12 +391,12 @@ TentPair tentBlend(std::uint32_t minus, std::uint32_t centre, std::uint32_t plus
 }
 
 // The samples ahead and behind of pixel i of the chunk, rounded half up.
-TentPair tentSamples(const TentRows& r, const ChunkTents& t, int i) {
-  const std::int32_t ux = t.ux[i];
+TentPair tentSamples(const TentRows& r, const ChunkUnits& u, int i) {
+  const std::int32_t ux = u.ux[i];
   const TentPair above = tentBlend(r.above[i - 1], r.above[i], r.above[i + 1], ux);
   const TentPair at = tentBlend(r.at[i - 1], r.at[i], r.at[i + 1], ux);
   const TentPair below = tentBlend(r.below[i - 1], r.below[i], r.below[i + 1], ux);
-  const std::int32_t uy = t.uy[i];
+  const std::int32_t uy = u.uy[i];
   const std::uint32_t ahead = tentBlend(above.ahead, at.ahead, below.ahead, uy).ahead;
   const std::uint32_t behind = tentBlend(above.behind, at.behind, below.behind, uy).behind;
   return {(ahead + 32768U) >> 16U, (behind + 32768U) >> 16U};
@@ -516,8 +513,10 @@ void strengthChunk(const Planes3& separated, const std::uint8_t* o, const std::u
   if (anySecond == 0) {
     return;
   }
+  ChunkUnits unitsQ8;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkUnits() fills it
+  chunkUnits(d, units, n, unitsQ8);
   ChunkTaps taps;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTaps() fills it
-  chunkTaps(d, units, n, taps);
+  chunkTaps(unitsQ8, n, taps);
   std::int16_t samples[6][kChunkPx];  // behind per channel, then ahead
   forEachRun(taps, n, [&](int i0, int i1, const RunOffsets& offsets) {
     for (std::size_t c = 0; c < 3; ++c) {
@@ -557,9 +556,9 @@ struct ChunkSamples {
   std::int32_t behind[kChunkPx];
 };
 
-void strengthSamples(const TentRows& rows, const ChunkTents& t, int n, ChunkSamples& out) {
+void strengthSamples(const TentRows& rows, const ChunkUnits& u, int n, ChunkSamples& out) {
   for (int i = 0; i < n; ++i) {
-    const TentPair pair = tentSamples(rows, t, i);
+    const TentPair pair = tentSamples(rows, u, i);
     out.ahead[i] = static_cast<std::int32_t>(pair.ahead);
     out.behind[i] = static_cast<std::int32_t>(pair.behind);
   }
@@ -653,10 +652,10 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
                  const SampleRing& ring, int minStrength, int y, int x0, int n, Boundary* b) {
   const ImageView<const std::uint16_t> st = strengths.relative;
   const std::uint16_t* s = st.rowPtr(y) + x0;
-  ChunkTents tents;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkTents() fills it
-  chunkTents(d + x0, units, n, tents);
+  ChunkUnits unitsQ8;  // NOLINT(cppcoreguidelines-pro-type-member-init): chunkUnits() fills it
+  chunkUnits(d + x0, units, n, unitsQ8);
   ChunkSamples samples;  // NOLINT(cppcoreguidelines-pro-type-member-init): filled next
-  strengthSamples(tentRows(s, strideOf(st)), tents, n, samples);
+  strengthSamples(tentRows(s, strideOf(st)), unitsQ8, n, samples);
   alignas(8) std::uint8_t isMax[kChunkPx] = {};
   for (int i = 0; i < n; ++i) {
     const std::int32_t s0 = s[i];
@@ -677,8 +676,8 @@ void maximaChunk(const InverseRow& inverse, const StrengthPlanes& strengths, con
       const Candidate c{x, samples.ahead[i], samples.behind[i]};
       if (o[x] == 1) {
         const std::uint16_t* pixel = derivative + i;
-        const std::int32_t ux = tents.ux[i];
-        const std::int32_t uy = tents.uy[i];
+        const std::int32_t ux = unitsQ8.ux[i];
+        const std::int32_t uy = unitsQ8.uy[i];
         b[x] = firstOrderBoundary(relativeValuesAt(ring, y, x), s[i], c,
                                   sampleAt(pixel, derivativeStride, tapQ8(-ux, -uy)), *pixel,
                                   sampleAt(pixel, derivativeStride, tapQ8(ux, uy)));
