@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Runs clang-tidy on translation units of a compilation database, skipping a unit whose last
+analysis found nothing and whose inputs have not changed since.
+
+A unit's inputs are hashed into its cache key:
+  - its preprocessed text (clang -E -C: every header it includes, and the comments, so that a
+    NOLINT removed from a header is seen), with the source and build folders' paths replaced by
+    placeholders so that a clone elsewhere shares the cache;
+  - its compile command (flags decide which compiler warnings clang-tidy reports) and its path
+    relative to the source folder (HeaderFilterRegex matches paths);
+  - the text of every .clang-tidy file of the source tree, the extra arguments, and the
+    clang-tidy and clang versions.
+Only clean results are stored: a unit with a finding is analysed again on every run and fails
+every run until the finding is fixed.
+
+Usage: clang_tidy_cached.py --clang-tidy BIN --clang BIN --build DIR --source-root DIR
+                            [--cache DIR] [--jobs N] [--extra-arg ARG ...] FILE...
+The cache defaults to $SMX_TIDY_CACHE, else $XDG_CACHE_HOME/stripemux/clang-tidy, else
+~/.cache/stripemux/clang-tidy. Exit status: 0 when no unit has a finding, 1 otherwise, 2 on a
+usage error (an unknown file, a missing tool).
+"""
+import argparse
+import concurrent.futures
+import hashlib
+import json
+import os
+import pathlib
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+
+KEY_FORMAT = b"stripemux-tidy-cache/1\n"
+
+
+def default_cache():
+    if os.environ.get("SMX_TIDY_CACHE"):
+        return pathlib.Path(os.environ["SMX_TIDY_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return pathlib.Path(base) / "stripemux" / "clang-tidy"
+
+
+def tool_version(binary):
+    return subprocess.run([binary, "--version"], check=True, capture_output=True).stdout
+
+
+def tidy_configs(source_root):
+    """The text of every .clang-tidy of the tree, keyed by its path in the tree."""
+    digest = hashlib.sha256()
+    for path in sorted(source_root.rglob(".clang-tidy")):
+        relative = path.relative_to(source_root)
+        if relative.parts[0] == "build" or ".git" in relative.parts:
+            continue
+        digest.update(str(relative).encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.digest()
+
+
+def command_args(entry):
+    if "arguments" in entry:
+        return list(entry["arguments"])
+    return shlex.split(entry["command"])
+
+
+def preprocess_args(args, clang, extra_args):
+    """The compile command turned into clang -E -C writing to standard output."""
+    out = [clang]
+    skip = False
+    for arg in args[1:]:
+        if skip:
+            skip = False
+            continue
+        if arg == "-o":
+            skip = True
+            continue
+        if arg == "-c" or arg.startswith("-o"):
+            continue
+        out.append(arg)
+    return out + extra_args + ["-E", "-C", "-w", "-o", "-"]
+
+
+class Unit:
+    def __init__(self, path, entry, build_dir, source_root):
+        self.path = path
+        self.entry = entry
+        self.relative = os.path.relpath(path, source_root)
+        self.build_dir = build_dir
+        self.source_root = source_root
+
+    def normalise(self, data):
+        # The build folder usually lies inside the source folder: replace it first.
+        data = data.replace(str(self.build_dir).encode(), b"<build>")
+        return data.replace(str(self.source_root).encode(), b"<source>")
+
+    def key(self, common, clang, extra_args):
+        args = command_args(self.entry)
+        result = subprocess.run(preprocess_args(args, clang, extra_args),
+                                cwd=self.entry["directory"], capture_output=True)
+        if result.returncode != 0:
+            return None  # let clang-tidy report why it cannot parse the unit
+        digest = hashlib.sha256(common)
+        digest.update(self.relative.encode() + b"\0")
+        digest.update(self.normalise(" ".join(args).encode()) + b"\0")
+        digest.update(self.normalise(result.stdout))
+        return digest.hexdigest()
+
+
+def analyse(unit, options, common):
+    """Returns (unit, status, output, seconds); status is 'cached', 'clean' or 'finding'."""
+    start = time.monotonic()
+    key = unit.key(common, options.clang, options.extra_arg)
+    entry = options.cache / key[:2] / key[2:] if key else None
+    if entry is not None and entry.exists():
+        os.utime(entry)  # recently used: kept by any pruning by age
+        return unit, "cached", "", time.monotonic() - start
+    command = [options.clang_tidy, "-p", str(options.build), "--quiet"]
+    command += ["--extra-arg=" + arg for arg in options.extra_arg] + [str(unit.path)]
+    result = subprocess.run(command, cwd=options.source_root, capture_output=True, text=True)
+    output = result.stdout + result.stderr
+    found = result.returncode != 0 or ": warning:" in output or ": error:" in output
+    if not found and entry is not None:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=entry.parent, delete=False) as tmp:
+            tmp.write(unit.relative + "\n")
+        os.replace(tmp.name, entry)
+    return unit, "finding" if found else "clean", output, time.monotonic() - start
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--clang-tidy", required=True)
+    parser.add_argument("--clang", required=True, help="clang++ of the same LLVM as clang-tidy")
+    parser.add_argument("--build", required=True, type=pathlib.Path,
+                        help="folder of compile_commands.json")
+    parser.add_argument("--source-root", required=True, type=pathlib.Path)
+    parser.add_argument("--cache", type=pathlib.Path, default=default_cache())
+    parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--extra-arg", action="append", default=[])
+    parser.add_argument("files", nargs="+", type=pathlib.Path)
+    options = parser.parse_args(argv)
+    options.build = options.build.resolve()
+    options.source_root = options.source_root.resolve()
+    return options
+
+
+def main(argv):
+    options = parse_args(argv)
+    database = json.loads((options.build / "compile_commands.json").read_text())
+    entries = {}
+    for entry in database:
+        path = pathlib.Path(entry["directory"], entry["file"]).resolve()
+        entries.setdefault(path, entry)
+    units = []
+    for file in options.files:
+        path = (options.source_root / file).resolve()
+        if path not in entries:
+            print(f"clang-tidy: {file} is not in {options.build}/compile_commands.json",
+                  file=sys.stderr)
+            return 2
+        units.append(Unit(path, entries[path], options.build, options.source_root))
+    try:
+        common = hashlib.sha256(KEY_FORMAT + tool_version(options.clang_tidy) +
+                                tool_version(options.clang) + tidy_configs(options.source_root) +
+                                "\0".join(options.extra_arg).encode()).digest()
+    except (OSError, subprocess.CalledProcessError) as error:
+        print(f"clang-tidy: {error}", file=sys.stderr)
+        return 2
+
+    counts = {"cached": 0, "clean": 0, "finding": 0}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, options.jobs)) as pool:
+        jobs = [pool.submit(analyse, unit, options, common) for unit in units]
+        for job in concurrent.futures.as_completed(jobs):
+            unit, status, output, seconds = job.result()
+            counts[status] += 1
+            print(f"{unit.relative}: {status} ({seconds:.1f} s)")
+            if status == "finding":
+                print(output, end="" if output.endswith("\n") else "\n")
+    print(f"clang-tidy: {len(units)} units, {counts['cached']} unchanged since a clean analysis, "
+          f"{counts['clean']} analysed clean, {counts['finding']} with findings "
+          f"(cache {options.cache})")
+    return 1 if counts["finding"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
