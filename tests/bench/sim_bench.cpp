@@ -13,6 +13,7 @@
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/renderer.hpp"
 #include "smx/sim/scene_json.hpp"
+#include "source_dir.hpp"
 
 namespace {
 
@@ -22,7 +23,7 @@ struct Setup {
 };
 
 Setup load(const std::string& rigName, const std::string& sceneName, int supersampling) {
-  const std::string root = SMX_SOURCE_DIR;
+  const std::string root = smx::test::sourceDir().string();
   auto rig = smx::protocol::loadRig(root + "/boards/sim/" + rigName + ".json");
   auto scene = smx::sim::loadScene(root + "/hal/sim/scenes/" + sceneName + ".json");
   if (!rig || !scene) {

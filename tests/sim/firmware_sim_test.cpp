@@ -23,6 +23,7 @@
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/sim_board.hpp"
+#include "source_dir.hpp"
 
 namespace smx {
 namespace {
@@ -30,7 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-const fs::path kSource = SMX_SOURCE_DIR;
+const fs::path kSource = smx::test::sourceDir();
 constexpr int kReplayFrames = 3;
 
 int cli(const std::vector<std::string>& args) {

@@ -6,6 +6,7 @@
 
 #include "cli.hpp"
 #include "smx/protocol/rig_json.hpp"
+#include "source_dir.hpp"
 
 namespace smx::test {
 
@@ -13,7 +14,7 @@ namespace fs = std::filesystem;
 
 namespace {
 fs::path boardsDir() {
-  return fs::path(SMX_SOURCE_DIR) / "boards";
+  return smx::test::sourceDir() / "boards";
 }
 }  // namespace
 

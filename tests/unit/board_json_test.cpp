@@ -7,10 +7,12 @@
 #include <iterator>
 #include <string>
 
+#include "source_dir.hpp"
+
 namespace smx::board {
 namespace {
 
-const std::filesystem::path kBoards = std::filesystem::path(SMX_SOURCE_DIR) / "boards";
+const std::filesystem::path kBoards = smx::test::sourceDir() / "boards";
 
 // The sim board's text with one substitution, parsed against the sim board folder.
 std::expected<Board, BoardError> simBoardWith(const std::string& from, const std::string& to) {

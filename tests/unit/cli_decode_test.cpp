@@ -13,13 +13,14 @@
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
+#include "source_dir.hpp"
 
 namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kRig2Cam = (fs::path(SMX_SOURCE_DIR) / "boards/sim/rig_2proj_2cam.json").string();
+const std::string kRig2Cam = (smx::test::sourceDir() / "boards/sim/rig_2proj_2cam.json").string();
 
 class CliDecode : public test::CliTest {
  protected:

@@ -8,13 +8,14 @@
 #include "cli.hpp"
 #include "cli_harness.hpp"
 #include "smx/sim/png_io.hpp"
+#include "source_dir.hpp"
 
 namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kRig = (fs::path(SMX_SOURCE_DIR) / "boards/sim/rig_2proj_1cam.json").string();
+const std::string kRig = (smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json").string();
 
 class CliDemux : public test::CliTest {
  protected:

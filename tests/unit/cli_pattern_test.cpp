@@ -9,6 +9,7 @@
 #include "pattern_sampler.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
+#include "source_dir.hpp"
 
 namespace smx::host {
 namespace {
@@ -30,7 +31,7 @@ const std::string kExampleRigs[] = {"rig_2proj_1cam.json", "rig_2proj_2cam.json"
 // size in which the stripe sequence is found along that projector's axis.
 TEST_F(CliPattern, WritesEachProjectorsPatternRecoverableAlongItsAxis) {
   for (const auto& name : kExampleRigs) {
-    const fs::path rigPath = fs::path(SMX_SOURCE_DIR) / "boards/sim" / name;
+    const fs::path rigPath = smx::test::sourceDir() / "boards/sim" / name;
     const auto out = dir_ / name;
     const auto result = run({"pattern", "--rig", rigPath.string(), "--out", out.string()});
     ASSERT_EQ(result.code, kExitOk) << result.err;
@@ -84,7 +85,7 @@ TEST_F(CliPattern, MissingOrMalformedRigFileIsBadInput) {
 
 TEST_F(CliPattern, UnwritableOutputIsAnIoError) {
   const auto blocker = writeFile("file", "not a directory");
-  const fs::path rigPath = fs::path(SMX_SOURCE_DIR) / "boards/sim/rig_2proj_1cam.json";
+  const fs::path rigPath = smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json";
   const auto result =
       run({"pattern", "--rig", rigPath.string(), "--out", (blocker / "sub").string()});
   EXPECT_EQ(result.code, kExitDeviceOrIo);

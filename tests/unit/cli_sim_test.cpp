@@ -13,13 +13,14 @@
 #include "cli_harness.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
+#include "source_dir.hpp"
 
 namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kRig2 = fs::path(SMX_SOURCE_DIR) / "boards/sim/rig_2proj_1cam.json";
+const fs::path kRig2 = smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json";
 
 class CliSim : public test::CliTest {
  protected:

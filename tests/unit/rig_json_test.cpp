@@ -18,6 +18,8 @@
 #include <string_view>
 #include <vector>
 
+#include "source_dir.hpp"
+
 namespace smx::protocol {
 namespace {
 
@@ -27,7 +29,7 @@ using algo::DeviceModel;
 using algo::Projector;
 using algo::Rig;
 
-const fs::path kSourceDir = SMX_SOURCE_DIR;
+const fs::path kSourceDir = smx::test::sourceDir();
 const fs::path kTestData = kSourceDir / "tests/unit/testdata/rigs";
 
 // Two cameras and two projectors, every value distinct so that one field can be replaced by text

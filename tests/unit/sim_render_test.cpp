@@ -18,6 +18,7 @@
 #include "smx/algo/stripe_code.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/renderer.hpp"
+#include "source_dir.hpp"
 
 // The renderer against geometry computed here, independently: ray–shape intersections, the
 // projection of docs/rig-format.md and the stripe formula of docs/pattern.md. Cameras are shrunk
@@ -31,7 +32,7 @@ using algo::Rgb8;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 algo::Rig exampleRig(const std::string& name) {
-  auto rig = protocol::loadRig(std::filesystem::path(SMX_SOURCE_DIR) / "boards" / "sim" / name);
+  auto rig = protocol::loadRig(smx::test::sourceDir() / "boards" / "sim" / name);
   if (!rig) {
     ADD_FAILURE() << rig.error().message();
     return {};

@@ -22,6 +22,7 @@
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/scene.hpp"
 #include "smx/sim/scene_json.hpp"
+#include "source_dir.hpp"
 
 namespace smx::sim {
 namespace {
@@ -29,7 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using Triangle = std::array<std::uint32_t, 3>;
 
-const fs::path kSourceDir = SMX_SOURCE_DIR;
+const fs::path kSourceDir = smx::test::sourceDir();
 const fs::path kTestData = kSourceDir / "tests/unit/testdata";
 const fs::path kShippedMeshes = kSourceDir / "hal/sim/scenes/meshes";
 
