@@ -109,20 +109,20 @@ def analyse(unit, options, common):
     """Returns (unit, status, output, seconds); status is 'cached', 'clean' or 'finding'."""
     start = time.monotonic()
     key = unit.key(common, options.clang, options.extra_arg)
-    entry = options.cache / key[:2] / key[2:] if key else None
-    if entry is not None and entry.exists():
-        os.utime(entry)  # recently used: kept by any pruning by age
+    stored = options.cache / key[:2] / key[2:] if key else None
+    if stored is not None and stored.exists():
+        os.utime(stored)  # recently used: kept by any pruning by age
         return unit, "cached", "", time.monotonic() - start
     command = [options.clang_tidy, "-p", str(options.build), "--quiet"]
     command += ["--extra-arg=" + arg for arg in options.extra_arg] + [str(unit.path)]
     result = subprocess.run(command, cwd=options.source_root, capture_output=True, text=True)
     output = result.stdout + result.stderr
     found = result.returncode != 0 or ": warning:" in output or ": error:" in output
-    if not found and entry is not None:
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile("w", dir=entry.parent, delete=False) as tmp:
+    if not found and stored is not None:
+        stored.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=stored.parent, delete=False) as tmp:
             tmp.write(unit.relative + "\n")
-        os.replace(tmp.name, entry)
+        os.replace(tmp.name, stored)
     return unit, "finding" if found else "clean", output, time.monotonic() - start
 
 
