@@ -14,6 +14,23 @@ double stripeCoordinate(const StripePattern& pattern, int projectorWidth, int pr
   return (alongAxis - pattern.offsetPx) / pattern.stripePx + stripe::kStripes / 2.0;
 }
 
+int visibleStripes(const Projector& p) {
+  const double a = p.pattern.angleDeg * std::numbers::pi / 180.0;
+  int visible = 0;
+  for (int i = 0; i < stripe::kStripes; ++i) {
+    bool inside = true;
+    for (const double edge : {static_cast<double>(i), i + 1.0}) {
+      const double along =
+          p.pattern.offsetPx + (edge - stripe::kStripes / 2.0) * p.pattern.stripePx;
+      const double u = (p.width - 1) / 2.0 + along * std::cos(a);
+      const double v = (p.height - 1) / 2.0 + along * std::sin(a);
+      inside = inside && u >= -0.5 && v >= -0.5 && u <= p.width - 0.5 && v <= p.height - 0.5;
+    }
+    visible += inside ? 1 : 0;
+  }
+  return visible;
+}
+
 Result<void> renderPatternImage(const Projector& projector, RgbView out) {
   if (out.width() != projector.width || out.height() != projector.height) {
     return fail(Errc::kSizeMismatch, "pattern image size differs from the projector's");

@@ -1,6 +1,7 @@
 #include "camera_images.hpp"
 
 #include <optional>
+#include <system_error>
 #include <utility>
 
 #include "smx/protocol/rig_json.hpp"
@@ -31,9 +32,37 @@ std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
       message += ")";
       return std::unexpected(message);
     }
-    out.push_back({*index, spec.substr(eq + 1)});
+    for (const auto& earlier : out) {
+      if (earlier.camera == *index) {
+        return std::unexpected("--image " + spec + ": camera " + id + " already has an image (" +
+                               earlier.file.string() + "); give one --image per camera");
+      }
+    }
+    const std::filesystem::path file = spec.substr(eq + 1);
+    std::error_code ec;
+    const auto status = std::filesystem::status(file, ec);
+    if (!std::filesystem::exists(status)) {
+      return std::unexpected("--image " + spec + ": no such file");
+    }
+    // A FIFO or device would block the reader, maybe forever.
+    if (!std::filesystem::is_regular_file(status)) {
+      return std::unexpected("--image " + spec + ": not a regular file");
+    }
+    out.push_back({*index, file});
   }
   return out;
+}
+
+std::expected<void, std::string> checkHasColour(const std::filesystem::path& file,
+                                                const sim::RgbImage& image) {
+  for (const algo::Rgb8& p : image.pixels) {
+    if (p.r != p.g || p.g != p.b) {
+      return {};
+    }
+  }
+  return std::unexpected(file.string() +
+                         ": the image has no colour (every pixel is grey); stripemux decodes "
+                         "colour stripes and needs the image of a colour camera");
 }
 
 std::expected<RigAndImages, std::string> loadRigAndImages(const std::filesystem::path& rigFile,

@@ -17,8 +17,8 @@ struct CameraImage {
   std::filesystem::path file;
 };
 
-// Each spec must be CAMERA=FILE with a camera id of the rig; errors name the spec and list the
-// rig's cameras.
+// Each spec must be CAMERA=FILE with a camera id of the rig, one per camera, and FILE a regular
+// file; errors name the spec and list the rig's cameras.
 [[nodiscard]] std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
     const std::vector<std::string>& specs, const algo::Rig& rig);
 
@@ -33,5 +33,10 @@ struct RigAndImages {
 // Reads the PNG and checks it has the camera's size; errors name the file.
 [[nodiscard]] std::expected<sim::RgbImage, std::string> readCameraImage(
     const std::filesystem::path& file, const algo::Camera& camera);
+
+// An image whose pixels are all grey holds no stripe colours: an error naming the file that says
+// so, rather than "0 depth pixels".
+[[nodiscard]] std::expected<void, std::string> checkHasColour(const std::filesystem::path& file,
+                                                              const sim::RgbImage& image);
 
 }  // namespace smx::host

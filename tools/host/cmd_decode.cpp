@@ -5,18 +5,19 @@
 #include <chrono>
 #include <cstddef>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
+#include <sstream>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include "camera_images.hpp"
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "demux_debug.hpp"
+#include "output_folder.hpp"
 #include "point_cloud.hpp"
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/sim/ply_io.hpp"
@@ -33,7 +34,7 @@ struct DecodeOptions {
   std::vector<std::string> images;  // CAM=FILE
   fs::path out;
   std::optional<fs::path> debug;
-  double nominalDepthM = 0.9;
+  double nominalDepthM = algo::kDefaultNominalDepthM;
   double depthUnitM = algo::kDefaultDepthUnitM;
 };
 
@@ -53,6 +54,17 @@ int countValid(algo::ConstDepthPlane depth) {
   return n;
 }
 
+// Depths beyond 65535 units are lost; a unit that cannot store the working range is refused.
+std::string depthUnitProblem(const DecodeOptions& opts) {
+  std::ostringstream s;
+  s << "--depth-unit " << opts.depthUnitM << ": 16-bit depth images in that unit store depths up "
+    << "to " << algo::maxStoredDepthM(opts.depthUnitM) << " m, and every depth beyond is lost; "
+    << "the rig works at " << opts.nominalDepthM << " m (--nominal-depth), so depths to "
+    << algo::kWorkingRangeFactor * opts.nominalDepthM << " m must fit: use --depth-unit "
+    << algo::minDepthUnitM(opts.nominalDepthM) << " or more";
+  return s.str();
+}
+
 std::expected<void, Failure> writeOrFail(const std::expected<void, std::string>& written) {
   if (!written) {
     return std::unexpected(Failure{kExitDeviceOrIo, written.error()});
@@ -60,37 +72,60 @@ std::expected<void, Failure> writeOrFail(const std::expected<void, std::string>&
   return {};
 }
 
-std::expected<void, Failure> writeDebug(const fs::path& dir, const algo::Camera& camera,
+std::expected<void, Failure> writePng(OutputFolder& folder, const std::string& name,
+                                      const sim::RgbImage& image) {
+  return writeOrFail(folder.write(
+      name, [&](const fs::path& file) { return sim::writePngRgb8(file, image.view()); }));
+}
+
+std::expected<void, Failure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
                                         const algo::Rig& rig, algo::CameraPipeline& pipeline) {
   for (int p = 0; p < pipeline.projectors(); ++p) {
     const std::string tag = rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id;
     if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
       return ok;
     }
-    if (auto ok = writeOrFail(sim::writePngRgb8(dir / (tag + ".stripes.png"),
-                                                renderStripes(pipeline.stripe(p)).view()));
-        !ok) {
+    if (auto ok = writePng(dir, tag + ".stripes.png", renderStripes(pipeline.stripe(p))); !ok) {
       return ok;
     }
-    if (auto ok = writeOrFail(
-            sim::writePngRgb8(dir / (tag + ".depth.png"), renderDepth(pipeline.depth(p)).view()));
-        !ok) {
+    if (auto ok = writePng(dir, tag + ".depth.png", renderDepth(pipeline.depth(p))); !ok) {
       return ok;
     }
   }
-  return writeOrFail(
-      sim::writePngRgb8(dir / (camera.id + ".depth.png"), renderDepth(pipeline.merged()).view()));
+  return writePng(dir, camera.id + ".depth.png", renderDepth(pipeline.merged()));
 }
+
+std::expected<void, Failure> writeDepth(OutputFolder& folder, const std::string& name,
+                                        algo::ConstDepthPlane depth) {
+  return writeOrFail(
+      folder.write(name, [&](const fs::path& file) { return sim::writePngGray16(file, depth); }));
+}
+
+std::expected<void, Failure> writePly(OutputFolder& folder, const std::string& name,
+                                      std::span<const sim::PlyPoint> points) {
+  return writeOrFail(
+      folder.write(name, [&](const fs::path& file) { return sim::writePlyPoints(file, points); }));
+}
+
+// The output folders of a run: --out, and --debug when given.
+struct Outputs {
+  OutputFolder out;
+  std::optional<OutputFolder> debug;
+};
 
 // Runs one camera's image through the pipeline, writes its files, and appends its meta.json entry
 // to `cameras` and its world points to `merged`.
 std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
-                                          const CameraImage& input, const CliStreams& io,
-                                          Json& cameras, std::vector<sim::PlyPoint>& merged) {
+                                          const CameraImage& input, std::ostream& report,
+                                          Outputs& outputs, Json& cameras,
+                                          std::vector<sim::PlyPoint>& merged) {
   const algo::Camera& camera = rig.cameras[input.camera];
   const auto image = readCameraImage(input.file, camera);
   if (!image) {
     return std::unexpected(Failure{kExitBadInput, image.error()});
+  }
+  if (auto colour = checkHasColour(input.file, *image); !colour) {
+    return std::unexpected(Failure{kExitBadInput, colour.error()});
   }
   algo::PipelineOptions options;
   options.nominalDepthM = opts.nominalDepthM;
@@ -101,15 +136,13 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
   }
   const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
   if (!bytes) {
-    return std::unexpected(
-        Failure{kExitBadInput, std::string("pipeline: ") + bytes.error().message});
+    return std::unexpected(Failure{kExitBadInput, bytes.error().message});
   }
   std::vector<std::byte> memory(*bytes);
   algo::Arena arena(memory);
   auto pipeline = algo::CameraPipeline::create(*setup, arena);
   if (!pipeline) {
-    return std::unexpected(
-        Failure{kExitBadInput, std::string("pipeline: ") + pipeline.error().message});
+    return std::unexpected(Failure{kExitBadInput, pipeline.error().message});
   }
 
   // The stages one by one, timed.
@@ -137,7 +170,7 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
   for (int p = 0; p < pipeline->projectors(); ++p) {
     const std::string name =
         rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id + ".depth.png";
-    if (auto w = writeOrFail(sim::writePngGray16(opts.out / name, pipeline->depth(p))); !w) {
+    if (auto w = writeDepth(outputs.out, name, pipeline->depth(p)); !w) {
       return std::unexpected(w.error());
     }
     const algo::DecodeStats& stats = pipeline->decodeStats(p);
@@ -148,26 +181,26 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
                      {"decoded_boundary_pixels", stats.decodedPixels}});
   }
   const std::string depthName = camera.id + ".depth.png";
-  if (auto w = writeOrFail(sim::writePngGray16(opts.out / depthName, pipeline->merged())); !w) {
+  if (auto w = writeDepth(outputs.out, depthName, pipeline->merged()); !w) {
     return std::unexpected(w.error());
   }
   const auto points =
       depthToWorldPoints(camera, pipeline->merged(), opts.depthUnitM, image->view());
   const std::string plyName = camera.id + ".ply";
-  if (auto w = writeOrFail(sim::writePlyPoints(opts.out / plyName, points)); !w) {
+  if (auto w = writePly(outputs.out, plyName, points); !w) {
     return std::unexpected(w.error());
   }
-  if (opts.debug) {
-    if (auto w = writeDebug(*opts.debug, camera, rig, *pipeline); !w) {
+  if (outputs.debug) {
+    if (auto w = writeDebug(*outputs.debug, camera, rig, *pipeline); !w) {
       return std::unexpected(w.error());
     }
   }
   const int valid = countValid(pipeline->merged());
-  io.out << camera.id << " (" << input.file.string() << "): " << valid << " depth pixels ("
+  report << camera.id << " (" << input.file.string() << "): " << valid << " depth pixels ("
          << (100 * valid) / (camera.width * camera.height) << " % of the image) in "
          << static_cast<int>(totalMs) << " ms, " << *bytes / 1024 << " KiB working memory\n";
   for (const auto& pair : pairs) {
-    io.out << "  " << pair["projector"].get<std::string>() << ": "
+    report << "  " << pair["projector"].get<std::string>() << ": "
            << pair["valid_pixels"].get<int>() << " depth pixels\n";
   }
   merged.insert(merged.end(), points.begin(), points.end());
@@ -189,39 +222,51 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
     io.err << "stripemux decode: " << message << "\n";
     return code;
   };
+  if (opts.depthUnitM < algo::minDepthUnitM(opts.nominalDepthM)) {
+    return fail(kExitUsage, depthUnitProblem(opts));
+  }
   const auto loaded = loadRigAndImages(opts.rig, opts.images);
   if (!loaded) {
     return fail(kExitBadInput, loaded.error());
   }
-  const algo::Rig* rig = &loaded->rig;
-  const std::vector<CameraImage>* images = &loaded->images;
-  for (const auto& dir : {std::optional(opts.out), opts.debug}) {
-    std::error_code ec;
-    if (dir && (fs::create_directories(*dir, ec), ec)) {
-      return fail(kExitDeviceOrIo,
-                  "cannot create directory " + dir->string() + ": " + ec.message());
+  auto out = OutputFolder::create(opts.out);
+  if (!out) {
+    return fail(kExitDeviceOrIo, out.error());
+  }
+  Outputs outputs{std::move(*out), std::nullopt};
+  if (opts.debug) {
+    auto debug = OutputFolder::create(*opts.debug);
+    if (!debug) {
+      return fail(kExitDeviceOrIo, debug.error());
     }
+    outputs.debug.emplace(std::move(*debug));
   }
   Json cameras = Json::array();
   std::vector<sim::PlyPoint> merged;
-  for (const CameraImage& input : *images) {
-    if (auto ok = decodeCamera(opts, *rig, input, io, cameras, merged); !ok) {
+  std::ostringstream report;
+  for (const CameraImage& input : loaded->images) {
+    if (auto ok = decodeCamera(opts, loaded->rig, input, report, outputs, cameras, merged); !ok) {
       return fail(ok.error().code, ok.error().message);
     }
   }
-  if (auto ok = sim::writePlyPoints(opts.out / "merged.ply", merged); !ok) {
-    return fail(kExitDeviceOrIo, ok.error());
+  if (auto ok = writePly(outputs.out, "merged.ply", merged); !ok) {
+    return fail(ok.error().code, ok.error().message);
   }
   const Json meta = {{"format", "stripemux-decode/1"}, {"depth_unit_m", opts.depthUnitM},
                      {"rig", opts.rig.string()},       {"cameras", cameras},
                      {"merged_ply", "merged.ply"},     {"merged_points", merged.size()}};
-  std::ofstream file(opts.out / "meta.json");
-  file << meta.dump(2) << "\n";
-  if (!file) {
-    return fail(kExitDeviceOrIo, "cannot write " + (opts.out / "meta.json").string());
+  if (auto ok = outputs.out.writeText(
+          "meta.json", meta.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
+      !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
   }
-  io.out << "wrote " << (opts.out / "merged.ply").string() << " (" << merged.size()
-         << " points) and " << (opts.out / "meta.json").string() << "\n";
+  for (OutputFolder* folder : {&outputs.out, outputs.debug ? &*outputs.debug : nullptr}) {
+    if (auto ok = folder != nullptr ? folder->commit() : std::expected<void, std::string>{}; !ok) {
+      return fail(kExitDeviceOrIo, ok.error());
+    }
+  }
+  io.out << report.str() << "wrote " << outputs.out.pathOf("merged.ply").string() << " ("
+         << merged.size() << " points) and " << outputs.out.pathOf("meta.json").string() << "\n";
   return kExitOk;
 }
 

@@ -7,13 +7,15 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include "camera_images.hpp"
 #include "commands.hpp"
 #include "demux_debug.hpp"
+#include "output_folder.hpp"
+#include "smx/algo/camera_pipeline.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/encoding_prediction.hpp"
 #include "smx/sim/png_io.hpp"
@@ -27,7 +29,7 @@ struct DemuxOptions {
   fs::path rig;
   std::vector<std::string> images;  // CAM=FILE
   std::optional<fs::path> debug;
-  double nominalDepthM = 0.9;
+  double nominalDepthM = algo::kDefaultNominalDepthM;
 };
 
 int runDemux(const DemuxOptions& opts, const CliStreams& io) {
@@ -41,19 +43,24 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
   }
   const algo::Rig* rig = &loaded->rig;
   const std::vector<CameraImage>* images = &loaded->images;
+  std::optional<OutputFolder> debug;
   if (opts.debug) {
-    std::error_code ec;
-    fs::create_directories(*opts.debug, ec);
-    if (ec) {
-      return fail(kExitDeviceOrIo,
-                  "cannot create debug directory " + opts.debug->string() + ": " + ec.message());
+    auto folder = OutputFolder::create(*opts.debug);
+    if (!folder) {
+      return fail(kExitDeviceOrIo, folder.error());
     }
+    debug.emplace(std::move(*folder));
   }
+  // Printed once the files are in place.
+  std::ostringstream report;
   for (const auto& [cameraIndex, file] : *images) {
     const algo::Camera& camera = rig->cameras[cameraIndex];
     const auto image = readCameraImage(file, camera);
     if (!image) {
       return fail(kExitBadInput, image.error());
+    }
+    if (auto colour = checkHasColour(file, *image); !colour) {
+      return fail(kExitBadInput, colour.error());
     }
     const algo::DemuxLayout layout{
         camera.width, camera.height, static_cast<int>(rig->projectors.size()), {}};
@@ -64,13 +71,13 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
     }
     const auto bytes = algo::Demultiplexer::workspaceBytes(layout);
     if (!bytes) {
-      return fail(kExitBadInput, std::string("demux: ") + bytes.error().message);
+      return fail(kExitBadInput, bytes.error().message);
     }
     std::vector<std::byte> memory(*bytes);
     algo::Arena arena(memory);
     auto demux = algo::Demultiplexer::create(layout, *predicted, arena);
     if (!demux) {
-      return fail(kExitBadInput, std::string("demux: ") + demux.error().message);
+      return fail(kExitBadInput, demux.error().message);
     }
     const auto start = std::chrono::steady_clock::now();
     if (auto ok = demux->run(image->view()); !ok) {
@@ -78,7 +85,7 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    io.out << camera.id << " (" << file.string() << "): demultiplexed in " << static_cast<int>(ms)
+    report << camera.id << " (" << file.string() << "): demultiplexed in " << static_cast<int>(ms)
            << " ms, " << *bytes / 1024 << " KiB working memory\n";
     for (int p = 0; p < layout.projectors; ++p) {
       const auto& projector = rig->projectors[static_cast<std::size_t>(p)];
@@ -93,18 +100,22 @@ int runDemux(const DemuxOptions& opts, const CliStreams& io) {
       for (const auto& tile : demux->tileDirections(p)) {
         present += tile.present;
       }
-      io.out << "  " << projector.id << ": " << boundaries << " boundary pixels, pattern found in "
+      report << "  " << projector.id << ": " << boundaries << " boundary pixels, pattern found in "
              << (100 * present) / layout.tileCount() << " % of the image\n";
-      if (opts.debug) {
+      if (debug) {
         const std::string tag = projector.id + "." + camera.id;
-        if (auto ok = writeDemuxDebug(*opts.debug, tag, *demux, p); !ok) {
+        if (auto ok = writeDemuxDebug(*debug, tag, *demux, p); !ok) {
           return fail(kExitDeviceOrIo, ok.error());
         }
-        io.out << "    wrote "
-               << (*opts.debug / (tag + ".{boundaries,separated,direction}.png")).string() << "\n";
+        report << "    wrote "
+               << debug->pathOf(tag + ".{boundaries,separated,direction}.png").string() << "\n";
       }
     }
   }
+  if (auto ok = debug ? debug->commit() : std::expected<void, std::string>{}; !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
+  }
+  io.out << report.str();
   return kExitOk;
 }
 

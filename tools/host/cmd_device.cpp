@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -13,9 +12,11 @@
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "device_client.hpp"
+#include "output_folder.hpp"
 #include "point_cloud.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
+#include "terminal_text.hpp"
 
 namespace smx::host {
 
@@ -46,22 +47,24 @@ bool isLoopback(const std::string& address) {
 
 std::string describe(const DeviceInfo& info) {
   std::ostringstream s;
-  s << "board " << info.board << ", firmware " << info.firmwareVersion << " (" << info.halBackend
-    << " HAL), " << info.cameras << (info.cameras == 1 ? " camera " : " cameras ") << info.width
-    << "x" << info.height << " at " << info.fps << " fps, " << info.projectors << " projectors";
+  s << "board " << printable(info.board) << ", firmware " << printable(info.firmwareVersion) << " ("
+    << printable(info.halBackend) << " HAL), " << info.cameras
+    << (info.cameras == 1 ? " camera " : " cameras ") << info.width << "x" << info.height << " at "
+    << info.fps << " fps, " << info.projectors << " projectors";
   return s.str();
 }
 
 int runInfo(const DeviceOptions& opts, const CliStreams& io) {
   auto client = DeviceClient::connect(opts.device, kConnectTimeout);
   if (!client) {
-    io.err << "stripemux info: " << client.error() << "\n";
+    io.err << "stripemux info: " << printable(client.error()) << "\n";
     return kExitDeviceOrIo;
   }
   const DeviceInfo& info = client->info();
   io.out << "device " << info.address << "\n"
-         << "  board:       " << info.board << "\n"
-         << "  firmware:    " << info.firmwareVersion << " (" << info.halBackend << " HAL)\n"
+         << "  board:       " << printable(info.board) << "\n"
+         << "  firmware:    " << printable(info.firmwareVersion) << " ("
+         << printable(info.halBackend) << " HAL)\n"
          << "  cameras:     " << info.cameras << " x " << info.width << "x" << info.height << " at "
          << info.fps << " fps:";
   for (const auto& camera : info.rig.cameras) {
@@ -227,9 +230,12 @@ void printSummary(const StreamTally& tally, const DeviceInfo& info, const Stream
       << ", <camera>.preview.png and summary.json\n";
 }
 
+// Each frame's files appear complete or not at all; a stream that fails keeps the frames it
+// received whole.
 class FrameWriter {
  public:
-  FrameWriter(const StreamOptions& opts, const DeviceInfo& info) : opts_(opts), info_(info) {}
+  FrameWriter(const StreamOptions& opts, const DeviceInfo& info, OutputFolder& out)
+      : opts_(opts), info_(info), out_(out) {}
 
   std::expected<void, std::string> write(const ReceivedFrame& frame) {
     const auto cameraIndex = static_cast<std::size_t>(frame.header.camera);
@@ -240,16 +246,26 @@ class FrameWriter {
     const algo::Camera& camera = info_.rig.cameras[cameraIndex];
     const auto depth =
         *algo::ConstDepthPlane::packed(frame.depth, frame.header.width, frame.header.height);
+    // camera.id passed the rig's id rules (parseRig), and the folder checks the name again.
     const std::string stem = camera.id + "_" + std::to_string(frame.header.frame);
-    if (auto ok = sim::writePngGray16(opts_.out / (stem + ".depth.png"), depth); !ok) {
+    if (auto ok =
+            out_.write(stem + ".depth.png",
+                       [&](const fs::path& file) { return sim::writePngGray16(file, depth); });
+        !ok) {
       return ok;
     }
     const double unitM = frame.header.depthUnitNm * 1e-9;
     auto points = depthToWorldPoints(camera, depth, unitM);
     if (!opts_.noPly) {
-      if (auto ok = sim::writePlyPoints(opts_.out / (stem + ".ply"), points); !ok) {
+      if (auto ok =
+              out_.write(stem + ".ply",
+                         [&](const fs::path& file) { return sim::writePlyPoints(file, points); });
+          !ok) {
         return ok;
       }
+    }
+    if (auto ok = out_.commit(); !ok) {
+      return ok;
     }
     // The latest capture: kept for merged.ply and the previews.
     if (frame.header.frame != latestFrame_) {
@@ -260,7 +276,7 @@ class FrameWriter {
     return {};
   }
 
-  // merged.ply and <camera>.preview.png of the latest capture.
+  // merged.ply and <camera>.preview.png of the latest capture (written, not yet committed).
   std::expected<std::string, std::string> finish() {
     std::vector<sim::PlyPoint> merged;
     for (const auto& [camera, kept] : latest_) {
@@ -268,12 +284,17 @@ class FrameWriter {
       const auto depth =
           *algo::ConstDepthPlane::packed(kept.depth, kept.header.width, kept.header.height);
       const std::string id = info_.rig.cameras[camera].id;
-      if (auto ok = sim::writePngRgb8(opts_.out / (id + ".preview.png"), renderDepth(depth).view());
+      if (auto ok = out_.write(id + ".preview.png",
+                               [&](const fs::path& file) {
+                                 return sim::writePngRgb8(file, renderDepth(depth).view());
+                               });
           !ok) {
         return std::unexpected(ok.error());
       }
     }
-    if (auto ok = sim::writePlyPoints(opts_.out / "merged.ply", merged); !ok) {
+    if (auto ok = out_.write(
+            "merged.ply", [&](const fs::path& file) { return sim::writePlyPoints(file, merged); });
+        !ok) {
       return std::unexpected(ok.error());
     }
     return "merged.ply (" + std::to_string(merged.size()) + " points of frame " +
@@ -288,6 +309,7 @@ class FrameWriter {
   };
   const StreamOptions& opts_;
   const DeviceInfo& info_;
+  OutputFolder& out_;
   std::uint64_t latestFrame_ = ~std::uint64_t{0};
   std::map<std::size_t, Kept> latest_;
 };
@@ -297,24 +319,22 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
       opts.compression == "none" ? protocol::Compression::kNone : protocol::Compression::kRvl;
   auto client = DeviceClient::connect(opts.device, kConnectTimeout);
   if (!client) {
-    io.err << "stripemux stream: " << client.error() << "\n";
+    io.err << "stripemux stream: " << printable(client.error()) << "\n";
     return kExitDeviceOrIo;
   }
   const DeviceInfo& info = client->info();
-  std::error_code ec;
-  fs::create_directories(opts.out, ec);
-  if (ec) {
-    io.err << "stripemux stream: cannot create " << opts.out.string() << ": " << ec.message()
-           << "\n";
+  auto out = OutputFolder::create(opts.out);
+  if (!out) {
+    io.err << "stripemux stream: " << out.error() << "\n";
     return kExitDeviceOrIo;
   }
   io.out << "connected to " << info.address << ": " << describe(info) << "\n";
   if (auto started = client->startStream(compression); !started) {
-    io.err << "stripemux stream: " << started.error() << "\n";
+    io.err << "stripemux stream: " << printable(started.error()) << "\n";
     return kExitDeviceOrIo;
   }
 
-  FrameWriter writer(opts, info);
+  FrameWriter writer(opts, info, *out);
   StreamTally tally;
   const bool loopback = isLoopback(info.address);
   const auto start = Clock::now();
@@ -322,7 +342,7 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
   std::optional<protocol::Statistics> deviceStats;
   bool stopping = false;
   const auto fail = [&](const std::string& message) {
-    io.err << "stripemux stream: " << info.address << ": " << message << "\n";
+    io.err << "stripemux stream: " << info.address << ": " << printable(message) << "\n";
     return kExitDeviceOrIo;
   };
   while (!deviceStats) {
@@ -368,8 +388,16 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
   }
 
   const protocol::Statistics device = deviceStats.value_or(protocol::Statistics{});  // set here
-  std::ofstream(opts.out / "summary.json")
-      << streamSummary(tally, info, opts, device, elapsedS).dump(2) << "\n";
+  if (auto ok = out->writeText("summary.json",
+                               streamSummary(tally, info, opts, device, elapsedS)
+                                       .dump(2, ' ', false, Json::error_handler_t::replace) +
+                                   "\n");
+      !ok) {
+    return fail(ok.error());
+  }
+  if (auto ok = out->commit(); !ok) {
+    return fail(ok.error());
+  }
   printSummary(tally, info, opts, device, elapsedS, *merged, io.out);
   return kExitOk;
 }

@@ -1,13 +1,13 @@
 // stripemux pattern --rig rig.json --out DIR
 // Writes each projector's pattern image, DIR/<projector-id>.png, as the projector must show it.
-#include <cmath>
 #include <filesystem>
 #include <memory>
-#include <numbers>
-#include <system_error>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "output_folder.hpp"
 #include "smx/algo/pattern_image.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
@@ -20,37 +20,18 @@ struct PatternOptions {
   std::filesystem::path out;
 };
 
-// Stripes whose whole width lies inside the projector image.
-int visibleStripes(const algo::Projector& p) {
-  const double a = p.pattern.angleDeg * std::numbers::pi / 180.0;
-  int visible = 0;
-  for (int i = 0; i < algo::stripe::kStripes; ++i) {
-    bool inside = true;
-    for (const double edge : {static_cast<double>(i), i + 1.0}) {
-      const double along =
-          p.pattern.offsetPx + (edge - algo::stripe::kStripes / 2.0) * p.pattern.stripePx;
-      const double u = (p.width - 1) / 2.0 + along * std::cos(a);
-      const double v = (p.height - 1) / 2.0 + along * std::sin(a);
-      inside = inside && u >= -0.5 && v >= -0.5 && u <= p.width - 0.5 && v <= p.height - 0.5;
-    }
-    visible += inside ? 1 : 0;
-  }
-  return visible;
-}
-
 int runPattern(const PatternOptions& opts, const CliStreams& io) {
   auto rig = protocol::loadRig(opts.rig);
   if (!rig) {
     io.err << "stripemux pattern: " << rig.error().message() << "\n";
     return kExitBadInput;
   }
-  std::error_code ec;
-  std::filesystem::create_directories(opts.out, ec);
-  if (ec) {
-    io.err << "stripemux pattern: cannot create output directory " << opts.out.string() << ": "
-           << ec.message() << "\n";
+  auto out = OutputFolder::create(opts.out);
+  if (!out) {
+    io.err << "stripemux pattern: " << out.error() << "\n";
     return kExitDeviceOrIo;
   }
+  std::string report;
   for (const auto& projector : rig->projectors) {
     std::vector<algo::Rgb8> pixels(static_cast<std::size_t>(projector.width) *
                                    static_cast<std::size_t>(projector.height));
@@ -63,16 +44,26 @@ int runPattern(const PatternOptions& opts, const CliStreams& io) {
       io.err << "stripemux pattern: " << projector.id << ": " << rendered.error().message << "\n";
       return kExitBadInput;
     }
-    const auto file = opts.out / (projector.id + ".png");
-    if (auto written = sim::writePngRgb8(file, *view); !written) {
+    const std::string name = projector.id + ".png";
+    if (auto written = out->write(
+            name,
+            [&](const std::filesystem::path& file) { return sim::writePngRgb8(file, *view); });
+        !written) {
       io.err << "stripemux pattern: " << written.error() << "\n";
       return kExitDeviceOrIo;
     }
-    io.out << "wrote " << file.string() << "  (" << projector.width << "x" << projector.height
-           << ", axis " << projector.pattern.angleDeg << " deg, " << projector.pattern.stripePx
-           << " px stripes, " << visibleStripes(projector) << " of " << algo::stripe::kStripes
-           << " stripes fully visible)\n";
+    std::ostringstream line;
+    line << "wrote " << out->pathOf(name).string() << "  (" << projector.width << "x"
+         << projector.height << ", axis " << projector.pattern.angleDeg << " deg, "
+         << projector.pattern.stripePx << " px stripes, " << algo::visibleStripes(projector)
+         << " of " << algo::stripe::kStripes << " stripes fully visible)\n";
+    report += line.str();
   }
+  if (auto committed = out->commit(); !committed) {
+    io.err << "stripemux pattern: " << committed.error() << "\n";
+    return kExitDeviceOrIo;
+  }
+  io.out << report;
   return kExitOk;
 }
 

@@ -6,14 +6,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <sstream>
-#include <system_error>
 #include <vector>
 
 #include "commands.hpp"
+#include "output_folder.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/pfm_io.hpp"
@@ -92,23 +91,32 @@ struct CameraTruth {
   }
 };
 
+template <class Pixel>
+std::expected<void, std::string> writePfm(OutputFolder& out, const std::string& name,
+                                          const Plane<Pixel>& plane) {
+  return out.write(name, [&](const fs::path& file) { return sim::writePfm(file, plane.view); });
+}
+
 std::expected<void, std::string> writeTruth(CameraTruth& truth, const algo::Rig& rig,
-                                            const fs::path& dir, const std::string& camTag) {
-  if (auto r = sim::writePfm(dir / (camTag + ".depth.pfm"), truth.depth.view); !r) {
+                                            OutputFolder& out, const std::string& camTag) {
+  if (auto r = writePfm(out, camTag + ".depth.pfm", truth.depth); !r) {
     return r;
   }
-  if (auto r = sim::writePfm(dir / (camTag + ".normal.pfm"), truth.normal.view); !r) {
+  if (auto r = writePfm(out, camTag + ".normal.pfm", truth.normal); !r) {
     return r;
   }
   for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
     const auto base = rig.projectors[p].id + "." + camTag;
-    if (auto r = sim::writePngGray8(dir / (base + ".lit.png"), truth.lit[p].view); !r) {
+    if (auto r = out.write(
+            base + ".lit.png",
+            [&](const fs::path& file) { return sim::writePngGray8(file, truth.lit[p].view); });
+        !r) {
       return r;
     }
     for (const auto& [suffix, plane] :
          {std::pair{".u.pfm", &truth.u[p]}, std::pair{".v.pfm", &truth.v[p]},
           std::pair{".stripe.pfm", &truth.stripe[p]}}) {
-      if (auto r = sim::writePfm(dir / (base + suffix), plane->view); !r) {
+      if (auto r = writePfm(out, base + suffix, *plane); !r) {
         return r;
       }
     }
@@ -141,12 +149,12 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
   if (!renderer) {
     return fail(kExitBadInput, renderer.error());
   }
-  std::error_code ec;
-  fs::create_directories(opts.out, ec);
-  if (ec) {
-    return fail(kExitDeviceOrIo,
-                "cannot create output directory " + opts.out.string() + ": " + ec.message());
+  auto out = OutputFolder::create(opts.out);
+  if (!out) {
+    return fail(kExitDeviceOrIo, out.error());
   }
+  // Printed once the files are in place.
+  std::ostringstream report;
 
   for (int frame = 0; frame < opts.frames; ++frame) {
     for (std::size_t c = 0; c < rig->cameras.size(); ++c) {
@@ -167,20 +175,27 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count();
-      const auto file = opts.out / (tag + ".png");
-      if (auto r = sim::writePngRgb8(file, image.view); !r) {
+      if (auto r =
+              out->write(tag + ".png",
+                         [&](const fs::path& file) { return sim::writePngRgb8(file, image.view); });
+          !r) {
         return fail(kExitDeviceOrIo, r.error());
       }
       if (truth) {
-        if (auto r = writeTruth(*truth, *rig, opts.out, tag); !r) {
+        if (auto r = writeTruth(*truth, *rig, *out, tag); !r) {
           return fail(kExitDeviceOrIo, r.error());
         }
       }
-      io.out << "wrote " << file.string() << "  (frame " << frame << ", " << camera.width << "x"
-             << camera.height << ", rendered in " << static_cast<int>(std::lround(ms)) << " ms"
-             << (truth ? ", with ground truth" : "") << ")\n";
+      report << "wrote " << out->pathOf(tag + ".png").string() << "  (frame " << frame << ", "
+             << camera.width << "x" << camera.height << ", rendered in "
+             << static_cast<int>(std::lround(ms)) << " ms" << (truth ? ", with ground truth" : "")
+             << ")\n";
     }
   }
+  if (auto committed = out->commit(); !committed) {
+    return fail(kExitDeviceOrIo, committed.error());
+  }
+  io.out << report.str();
   return kExitOk;
 }
 

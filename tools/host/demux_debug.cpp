@@ -84,8 +84,7 @@ sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
   return out;
 }
 
-std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& dir,
-                                                 const std::string& tag,
+std::expected<void, std::string> writeDemuxDebug(OutputFolder& dir, const std::string& tag,
                                                  const algo::Demultiplexer& demux, int projector) {
   const algo::ImageView<const std::int16_t> separated[3] = {
       demux.separated(projector, 0), demux.separated(projector, 1), demux.separated(projector, 2)};
@@ -96,7 +95,11 @@ std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& di
        renderDirections(demux.directions(projector), demux.boundaries(projector))},
   };
   for (const auto& [suffix, image] : images) {
-    if (auto ok = sim::writePngRgb8(dir / (tag + suffix), image.view()); !ok) {
+    if (auto ok = dir.write(tag + suffix,
+                            [&](const std::filesystem::path& file) {
+                              return sim::writePngRgb8(file, image.view());
+                            });
+        !ok) {
       return ok;
     }
   }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <string>
 
+#include "output_folder.hpp"
 #include "smx/algo/boundary_map.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/image_view.hpp"
@@ -27,9 +28,9 @@ namespace smx::host {
 [[nodiscard]] sim::RgbImage renderDirections(algo::ConstDirectionPlane directions,
                                              algo::ConstBoundaryPlane boundaries);
 
-// Writes the three renderings above of one projector as DIR/<tag>.{boundaries,separated,
+// Writes the three renderings above of one projector into `dir` as <tag>.{boundaries,separated,
 // direction}.png; the separated view is the last projector separated (Demultiplexer::separated).
-[[nodiscard]] std::expected<void, std::string> writeDemuxDebug(const std::filesystem::path& dir,
+[[nodiscard]] std::expected<void, std::string> writeDemuxDebug(OutputFolder& dir,
                                                                const std::string& tag,
                                                                const algo::Demultiplexer& demux,
                                                                int projector);

@@ -9,7 +9,10 @@
 #include <optional>
 #include <utility>
 
+#include "smx/algo/camera_pipeline.hpp"
+#include "smx/algo/range_image.hpp"
 #include "smx/config/field_reader.hpp"
+#include "smx/config/identifier.hpp"
 #include "smx/config/json_reader.hpp"
 #include "smx/protocol/rig_json.hpp"
 
@@ -241,6 +244,10 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
   hal::BoardConfig& board = out.config;
   board.directory = dir;
   board.name = r.text(doc, "", "name", "the board's name, e.g. \"rpi4\"").value_or("");
+  // The name goes on the wire to every host and onto their terminals: an id, not free text.
+  if (auto problem = r.ok() ? config::identifierProblem(board.name) : std::nullopt) {
+    r.fail("name", std::move(*problem));
+  }
   board.backend = r.word(doc, "", "hal", kHals).value_or("");
   const auto rigFile = r.text(doc, "", "rig", "the rig.json file, relative to the board folder");
   if (rigFile) {
@@ -256,6 +263,15 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
   if (r.ok() && (board.depthUnitM < 1e-6 || board.depthUnitM > 1e-2)) {
     r.fail("depth_unit_m", "must be from 1e-06 (1 um) to 0.01 (1 cm), got " +
                                config::formatNumber(board.depthUnitM));
+  }
+  if (r.ok() && board.depthUnitM < algo::minDepthUnitM(algo::kDefaultNominalDepthM)) {
+    r.fail("depth_unit_m",
+           config::formatNumber(board.depthUnitM) + " m per unit stores depths up to " +
+               config::formatNumber(algo::maxStoredDepthM(board.depthUnitM)) +
+               " m in 16 bits; the board decodes for " +
+               config::formatNumber(algo::kDefaultNominalDepthM) +
+               " m, and every depth beyond the limit would be lost; use at least " +
+               config::formatNumber(algo::minDepthUnitM(algo::kDefaultNominalDepthM)));
   }
   if (r.ok()) {
     readCameras(r, doc, out.rig, board);

@@ -13,6 +13,9 @@
 #include <utility>
 #include <vector>
 
+#include "smx/algo/demux.hpp"
+#include "smx/algo/pattern_image.hpp"
+#include "smx/config/identifier.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_keys.hpp"
 #include "smx/config/json_paths.hpp"
@@ -31,8 +34,25 @@ using config::formatNumber;
 using config::jsonQuote;
 using config::member;
 
-// Larger images are certainly a typo, and a bound keeps width * height far from int overflow.
-constexpr int kMaxImageSidePx = 65535;
+// Physical plausibility (docs/rig-format.md, "Limits"): values no real rig has are typos or
+// hostile, and refusing them here keeps every later allocation and computation bounded.
+// 8192: larger than any projector and than the cameras a board decodes at video rate; 8192² RGB
+// is 200 MB, so a rig can never make a command allocate more than a few GB.
+constexpr int kMaxImageSidePx = 8192;
+// Smaller images cannot hold a code window of stripes or one demultiplexing tile.
+constexpr int kMinImageSidePx = 16;
+// Focal lengths from 0.1 (a fisheye's 157 degree field) to 100 (0.6 degree) times the image side.
+constexpr double kMinFocalPerSide = 0.1;
+constexpr double kMaxFocalPerSide = 100.0;
+// Lens distortion coefficients beyond this bend a ray by more than any lens a scanner uses.
+constexpr double kMaxDistortion = 100.0;
+// A rig fits in a room: every translation component within 100 m of the world origin.
+constexpr double kMaxTranslationM = 100.0;
+constexpr double kMaxAngleDeg = 360.0;
+// A stripe narrower than a projector pixel cannot be shown.
+constexpr double kMinStripePx = 1.0;
+// Boards read at most this many cameras (the wire numbers them in one byte).
+constexpr std::size_t kMaxCameras = 16;
 constexpr std::string_view kKStructure = "K is [fx 0 cx; 0 fy cy; 0 0 1]";
 
 constexpr std::array<std::string_view, 3> kTopKeys = {"format", "cameras", "projectors"};
@@ -89,9 +109,11 @@ std::expected<std::string, RigError> readString(const Json& v, const std::string
 }
 
 std::string sizeProblem(double v) {
-  return v > kMaxImageSidePx ? "must be at most " + std::to_string(kMaxImageSidePx) +
-                                   " pixels, got " + formatNumber(v)
-                             : "must be a positive integer (pixels), got " + formatNumber(v);
+  if (v != std::floor(v) || v < 1) {
+    return "must be a positive integer (pixels), got " + formatNumber(v);
+  }
+  return "must be from " + std::to_string(kMinImageSidePx) + " to " +
+         std::to_string(kMaxImageSidePx) + " pixels, got " + formatNumber(v);
 }
 
 std::expected<int, RigError> readSize(const Json& v, const std::string& path) {
@@ -100,7 +122,7 @@ std::expected<int, RigError> readSize(const Json& v, const std::string& path) {
     return std::unexpected(d.error());
   }
   // 640.0 is accepted: it is an integer, only written differently.
-  if (*d != std::floor(*d) || *d < 1 || *d > kMaxImageSidePx) {
+  if (*d != std::floor(*d) || *d < kMinImageSidePx || *d > kMaxImageSidePx) {
     return fail(path, sizeProblem(*d));
   }
   return static_cast<int>(*d);
@@ -135,7 +157,7 @@ Status checkFinite(std::span<const double> values, const std::string& path) {
 }
 
 Status checkSize(int v, const std::string& path) {
-  if (v < 1 || v > kMaxImageSidePx) {
+  if (v < kMinImageSidePx || v > kMaxImageSidePx) {
     return fail(path, sizeProblem(v));
   }
   return {};
@@ -165,6 +187,45 @@ Status checkIntrinsics(const std::array<double, 9>& intrinsics, const std::strin
   return {};
 }
 
+// Called after checkIntrinsics: K has its structure, fx and fy are positive.
+Status checkIntrinsicsPlausible(const algo::DeviceModel& d, const std::string& path) {
+  struct Entry {
+    std::size_t index;
+    double lo;
+    double hi;
+    const char* what;
+  };
+  const double w = d.width;
+  const double h = d.height;
+  const std::array<Entry, 4> entries = {{
+      {0, kMinFocalPerSide * w, kMaxFocalPerSide * w, "fx (0.1 to 100 times the width)"},
+      {2, -w, 2 * w, "cx (from -width to 2 times the width)"},
+      {4, kMinFocalPerSide * h, kMaxFocalPerSide * h, "fy (0.1 to 100 times the height)"},
+      {5, -h, 2 * h, "cy (from -height to 2 times the height)"},
+  }};
+  for (const auto& e : entries) {
+    const double k = d.K[e.index];
+    if (k < e.lo || k > e.hi) {
+      return fail(element(path, e.index), std::string(e.what) + " must be from " +
+                                              formatNumber(e.lo) + " to " + formatNumber(e.hi) +
+                                              " pixels, got " + formatNumber(k));
+    }
+  }
+  return {};
+}
+
+Status checkWithin(std::span<const double> values, double limit, const std::string& path,
+                   const char* what) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (std::abs(values[i]) > limit) {
+      return fail(element(path, i), std::string(what) + " must be from -" + formatNumber(limit) +
+                                        " to " + formatNumber(limit) + ", got " +
+                                        formatNumber(values[i]));
+    }
+  }
+  return {};
+}
+
 Status checkRotation(const std::array<double, 9>& r, const std::string& path) {
   if (auto problem = config::rotationProblem(r)) {
     return fail(path, std::move(*problem));
@@ -175,8 +236,8 @@ Status checkRotation(const std::array<double, 9>& r, const std::string& path) {
 class IdRegistry {
  public:
   Status add(const std::string& id, const std::string& path) {
-    if (id.empty()) {
-      return fail(member(path, "id"), "must not be empty");
+    if (auto problem = config::identifierProblem(id)) {
+      return fail(member(path, "id"), std::move(*problem));
     }
     const auto [it, inserted] = owners_.emplace(id, path);
     if (!inserted) {
@@ -206,7 +267,15 @@ Status checkDevice(const algo::DeviceModel& d, const std::string& path, IdRegist
   if (auto s = checkIntrinsics(d.K, member(path, "K")); !s) {
     return s;
   }
+  if (auto s = checkIntrinsicsPlausible(d, member(path, "K")); !s) {
+    return s;
+  }
   if (auto s = checkFinite(d.dist, member(path, "dist")); !s) {
+    return s;
+  }
+  if (auto s =
+          checkWithin(d.dist, kMaxDistortion, member(path, "dist"), "a distortion coefficient");
+      !s) {
     return s;
   }
   if (auto s = checkFinite(d.R, member(path, "R")); !s) {
@@ -215,10 +284,14 @@ Status checkDevice(const algo::DeviceModel& d, const std::string& path, IdRegist
   if (auto s = checkRotation(d.R, member(path, "R")); !s) {
     return s;
   }
-  return checkFinite(d.t, member(path, "t"));
+  if (auto s = checkFinite(d.t, member(path, "t")); !s) {
+    return s;
+  }
+  return checkWithin(d.t, kMaxTranslationM, member(path, "t"), "a translation (metres)");
 }
 
-Status checkPattern(const algo::StripePattern& p, const std::string& path) {
+Status checkPattern(const algo::Projector& projector, const std::string& path) {
+  const algo::StripePattern& p = projector.pattern;
   const std::array<double, 3> values = {p.angleDeg, p.stripePx, p.offsetPx};
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i])) {
@@ -229,14 +302,42 @@ Status checkPattern(const algo::StripePattern& p, const std::string& path) {
   if (!(p.stripePx > 0)) {
     return fail(member(path, "stripe_px"), "must be positive, got " + formatNumber(p.stripePx));
   }
+  if (p.stripePx < kMinStripePx) {
+    return fail(member(path, "stripe_px"),
+                "must be at least 1 (a stripe narrower than a projector pixel cannot be shown), "
+                "got " +
+                    formatNumber(p.stripePx));
+  }
+  if (std::abs(p.angleDeg) > kMaxAngleDeg) {
+    return fail(member(path, "angle_deg"),
+                "must be from -360 to 360 degrees, got " + formatNumber(p.angleDeg));
+  }
+  if (const int visible = algo::visibleStripes(projector); visible < algo::stripe::kWindowStripes) {
+    return fail(path, "shows " + std::to_string(visible) + " whole stripes in the " +
+                          std::to_string(projector.width) + "x" + std::to_string(projector.height) +
+                          " projector image; a stripe is identified by a window of " +
+                          std::to_string(algo::stripe::kWindowStripes) +
+                          ", so stripe_px or offset_px is wrong");
+  }
   return {};
 }
 
-Status checkCount(std::size_t n, const std::string& path, std::string_view what) {
+Status checkCount(std::size_t n, const std::string& path, std::string_view what, std::size_t most) {
   if (n == 0) {
     return fail(path, "at least one " + std::string(what) + " is required, got none");
   }
+  if (n > most) {
+    return fail(path, "at most " + std::to_string(most) + " " + std::string(what) + "s" +
+                          (what == "projector" ? " (the method separates up to 3 pattern "
+                                                 "orientations in one image)"
+                                               : "") +
+                          ", got " + std::to_string(n));
+  }
   return {};
+}
+
+std::size_t mostOf(std::string_view what) {
+  return what == "projector" ? std::size_t{algo::kMaxProjectors} : kMaxCameras;
 }
 
 // --- reading: JSON structure -> Rig ---
@@ -331,7 +432,7 @@ Status readDevice(const Json& obj, const std::string& path, IdRegistry& ids, Dev
         !s) {
       return s;
     }
-    return checkPattern(d.pattern, at);
+    return checkPattern(d, at);
   }
   return {};
 }
@@ -347,7 +448,7 @@ std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, std::s
   if (!it->is_array()) {
     return fail(path, "must be an array of " + std::string(what) + "s, got " + describe(*it));
   }
-  if (auto s = checkCount(it->size(), path, what); !s) {
+  if (auto s = checkCount(it->size(), path, what, mostOf(what)); !s) {
     return std::unexpected(s.error());
   }
   std::vector<Device> devices(it->size());
@@ -452,7 +553,7 @@ std::expected<algo::Rig, RigError> loadRig(const std::filesystem::path& path) {
 std::expected<void, RigError> validateRig(const algo::Rig& rig) {
   try {
     IdRegistry ids;
-    if (auto s = checkCount(rig.cameras.size(), "cameras", "camera"); !s) {
+    if (auto s = checkCount(rig.cameras.size(), "cameras", "camera", kMaxCameras); !s) {
       return s;
     }
     for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
@@ -460,7 +561,8 @@ std::expected<void, RigError> validateRig(const algo::Rig& rig) {
         return s;
       }
     }
-    if (auto s = checkCount(rig.projectors.size(), "projectors", "projector"); !s) {
+    if (auto s = checkCount(rig.projectors.size(), "projectors", "projector", algo::kMaxProjectors);
+        !s) {
       return s;
     }
     for (std::size_t i = 0; i < rig.projectors.size(); ++i) {
@@ -468,7 +570,7 @@ std::expected<void, RigError> validateRig(const algo::Rig& rig) {
       if (auto s = checkDevice(rig.projectors[i], at, ids); !s) {
         return s;
       }
-      if (auto s = checkPattern(rig.projectors[i].pattern, member(at, "pattern")); !s) {
+      if (auto s = checkPattern(rig.projectors[i], member(at, "pattern")); !s) {
         return s;
       }
     }

@@ -143,6 +143,10 @@ std::expected<std::string, FieldError> readDocumentFile(const std::filesystem::p
     if (std::filesystem::is_directory(status)) {
       return fail({}, "cannot read the file: it is a directory");
     }
+    // A FIFO or socket would block the reader until something writes to it, maybe forever.
+    if (!std::filesystem::is_regular_file(status)) {
+      return fail({}, "cannot read the file: it is not a regular file (a pipe, socket or device)");
+    }
     std::ifstream in(file, std::ios::binary);
     if (!in) {
       return fail(

@@ -21,7 +21,8 @@ std::expected<void, std::string> writeRows(const std::filesystem::path& path, ch
     out.write(reinterpret_cast<const char*>(row.data()),
               static_cast<std::streamsize>(row.size_bytes()));
   }
-  if (!out.flush()) {
+  out.close();
+  if (!out) {
     return std::unexpected(path.string() + ": write failed");
   }
   return {};

@@ -42,6 +42,8 @@ std::expected<void, std::string> writePlyPoints(const std::filesystem::path& pat
     at += kRecordBytes;
   }
   out.write(body.data(), static_cast<std::streamsize>(body.size()));
+  // Buffered bytes are written at close; a full disk shows there, not at write().
+  out.close();
   if (!out) {
     return failure(path, "write failed");
   }

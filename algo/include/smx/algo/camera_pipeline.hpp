@@ -23,8 +23,11 @@
 // allocation-free; all memory is carved from one arena at create().
 namespace smx::algo {
 
+// Where the rig predicts the pattern directions when nothing says otherwise (a board, the CLI).
+inline constexpr double kDefaultNominalDepthM = 0.9;
+
 struct PipelineOptions {
-  double nominalDepthM = 0.9;  // where the rig predicts the pattern directions
+  double nominalDepthM = kDefaultNominalDepthM;  // where the rig predicts the pattern directions
   double depthUnitM = kDefaultDepthUnitM;
   DemuxParams demux;
   DecodeParams decode;

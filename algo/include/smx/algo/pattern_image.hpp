@@ -28,6 +28,10 @@ namespace smx::algo {
   return {0, 0, 0};
 }
 
+// Stripes whose whole width lies inside the projector image. Fewer than a code window
+// (stripe::kWindowStripes) and no stripe of the pattern can be identified.
+[[nodiscard]] int visibleStripes(const Projector& projector);
+
 // Fills `out` (projector width × height) with the pattern, each pixel coloured by the stripe at
 // its centre.
 [[nodiscard]] Result<void> renderPatternImage(const Projector& projector, RgbView out);

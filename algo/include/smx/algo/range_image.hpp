@@ -23,6 +23,21 @@ using ConstStripePlane = ImageView<const StripeQ16>;
 // depth-scale convention of depth cameras.
 inline constexpr std::uint16_t kNoDepth = 0;
 inline constexpr double kDefaultDepthUnitM = 0.0001;
+inline constexpr double kMaxDepthUnits = 65535;
+
+// The farthest z a range image in `depthUnitM` stores; anything beyond is lost (kNoDepth).
+[[nodiscard]] constexpr double maxStoredDepthM(double depthUnitM) {
+  return kMaxDepthUnits * depthUnitM;
+}
+
+// A scan reaches beyond the distance the rig is set up for (its nominal depth): the back of the
+// object, the wall behind it. A depth unit must store at least this many times that distance.
+inline constexpr double kWorkingRangeFactor = 2.0;
+
+// The smallest depth unit that stores kWorkingRangeFactor × nominalDepthM.
+[[nodiscard]] constexpr double minDepthUnitM(double nominalDepthM) {
+  return kWorkingRangeFactor * nominalDepthM / kMaxDepthUnits;
+}
 using DepthPlane = ImageView<std::uint16_t>;
 using ConstDepthPlane = ImageView<const std::uint16_t>;
 

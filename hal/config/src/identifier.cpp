@@ -1,0 +1,48 @@
+#include "smx/config/identifier.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace smx::config {
+namespace {
+
+bool isAlnum(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+
+bool isIdentifierChar(char c) {
+  return isAlnum(c) || c == '_' || c == '-' || c == '.';
+}
+
+// The id as JSON with every non-ASCII byte escaped, cut to a readable length: the message
+// itself must carry no control characters or escape sequences.
+std::string shown(std::string_view id) {
+  constexpr std::size_t kMaxShown = 40;
+  const std::string_view cut = id.substr(0, kMaxShown);
+  return nlohmann::json(std::string(cut))
+             .dump(-1, ' ', true, nlohmann::json::error_handler_t::replace) +
+         (cut.size() < id.size() ? "..." : "");
+}
+
+}  // namespace
+
+std::optional<std::string> identifierProblem(std::string_view id) {
+  const std::string rule = "; ids are 1 to " + std::to_string(kMaxIdentifierLength) +
+                           " characters of A-Z a-z 0-9 _ - . starting with a letter or digit";
+  if (id.empty()) {
+    return "must not be empty" + rule;
+  }
+  if (id.size() > kMaxIdentifierLength) {
+    return "is " + std::to_string(id.size()) + " characters long" + rule;
+  }
+  if (!isAlnum(id.front())) {
+    return "must start with a letter or digit, got " + shown(id) + rule;
+  }
+  for (const char c : id) {
+    if (!isIdentifierChar(c)) {
+      return shown(id) + " has a character that is not allowed in an id" + rule;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace smx::config
