@@ -92,6 +92,21 @@ TEST(BoardJson, ErrorsNameTheField) {
   expectError(simBoardWith("stripemux-board/1", "stripemux-rig/1"), "format", "this is a rig.json");
 }
 
+// The board's name goes on the wire to every host: an id, not free text.
+TEST(BoardJson, TheNameIsAnId) {
+  expectError(simBoardWith(R"("name": "sim")", R"("name": "sim\u001b]0;x\u0007")"), "name",
+              "has a character that is not allowed");
+  expectError(simBoardWith(R"("name": "sim")", R"("name": "../sim")"), "name",
+              "must start with a letter or digit");
+}
+
+// A depth unit whose 16 bits cannot hold twice the board's working distance would lose depths.
+TEST(BoardJson, DepthUnitMustHoldTheWorkingRange) {
+  expectError(simBoardWith(R"("depth_unit_m": 0.0001)", R"("depth_unit_m": 1e-6)"), "depth_unit_m",
+              "every depth beyond the limit would be lost");
+  EXPECT_TRUE(simBoardWith(R"("depth_unit_m": 0.0001)", R"("depth_unit_m": 2.75e-5)").has_value());
+}
+
 TEST(BoardJson, AMissingFileIsNamed) {
   const auto board = loadBoard(kBoards / "no-such-board");
   ASSERT_FALSE(board.has_value());

@@ -291,6 +291,83 @@ TEST(RigJsonErrors, StripeWidthMustBePositive) {
                  "projectors[0].pattern.stripe_px", {"must be positive", "got -6"});
 }
 
+// Values no real rig has are refused naming the field, before anything is sized from them.
+TEST(RigJsonErrors, PhysicallyImplausibleValuesAreRefused) {
+  expectRejected(validRigWith("\"width\": 640", "\"width\": 65535"), "cameras[0].width",
+                 {"must be from 16 to 8192 pixels", "got 65535"});
+  expectRejected(validRigWith("\"height\": 480", "\"height\": 8"), "cameras[0].height",
+                 {"must be from 16 to 8192 pixels", "got 8"});
+  expectRejected(validRigWith("\"stripe_px\": 6", "\"stripe_px\": 1e-300"),
+                 "projectors[0].pattern.stripe_px", {"must be at least 1", "got 1e-300"});
+  expectRejected(validRigWith("\"stripe_px\": 6", "\"stripe_px\": 1e300"), "projectors[0].pattern",
+                 {"shows 0 whole stripes", "1024x768", "window of 7"});
+  expectRejected(validRigWith("\"offset_px\": -2.25", "\"offset_px\": -1e6"),
+                 "projectors[1].pattern", {"shows 0 whole stripes"});
+  expectRejected(validRigWith("\"angle_deg\": 90", "\"angle_deg\": 1e300"),
+                 "projectors[1].pattern.angle_deg", {"from -360 to 360", "got 1e+300"});
+  const std::string k = "1610.5, 0, 640.25, 0, 1611.5, 479.75, 0, 0, 1";
+  expectRejected(validRigWith(k, "1e9, 0, 640.25, 0, 1611.5, 479.75, 0, 0, 1"), "cameras[1].K[0]",
+                 {"fx (0.1 to 100 times the width)", "128 to 128000", "got 1000000000"});
+  expectRejected(validRigWith(k, "1610.5, 0, 640.25, 0, 1e-3, 479.75, 0, 0, 1"), "cameras[1].K[4]",
+                 {"fy (0.1 to 100 times the height)", "got 0.001"});
+  expectRejected(validRigWith(k, "1610.5, 0, -1e5, 0, 1611.5, 479.75, 0, 0, 1"), "cameras[1].K[2]",
+                 {"cx", "got -100000"});
+  expectRejected(validRigWith(k, "1610.5, 0, 640.25, 0, 1611.5, 1e7, 0, 0, 1"), "cameras[1].K[5]",
+                 {"cy", "got 10000000"});
+  expectRejected(validRigWith("\"dist\": [0.1, 0, 0, 0, 0.2]", "\"dist\": [0.1, 0, 0, 0, 1e5]"),
+                 "projectors[1].dist[4]", {"distortion", "got 100000"});
+  expectRejected(validRigWith("\"t\": [0.25, -0.01, 0.02]", "\"t\": [0.25, -1e4, 0.02]"),
+                 "cameras[1].t[1]", {"translation", "got -10000"});
+}
+
+// The method separates up to three pattern orientations in one image; a rig with more projectors
+// (or more cameras than a board reads) is refused at the list, not later by a pipeline stage.
+TEST(RigJsonErrors, DeviceCountsAreBounded) {
+  const std::string projector = R"({"id": "pX", "width": 800, "height": 600,
+     "K": [1200, 0, 399.5, 0, 1203, 299.5, 0, 0, 1], "dist": [0, 0, 0, 0, 0],
+     "R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [0, 0, 0],
+     "pattern": {"angle_deg": 0, "stripe_px": 6, "offset_px": 0}})";
+  std::string extra;
+  for (int i = 0; i < 8; ++i) {
+    std::string p = projector;
+    p.replace(p.find("pX"), 2, "p" + std::to_string(i));
+    extra += ",\n" + p;
+  }
+  expectRejected(validRigWith("\"offset_px\": -2.25}}", "\"offset_px\": -2.25}}" + extra),
+                 "projectors", {"at most 3 projectors", "got 10"});
+  std::string cameras;
+  for (int i = 0; i < 17; ++i) {
+    cameras += std::string(i == 0 ? "" : ",\n") + R"({"id": "c)" + std::to_string(i) +
+               R"(", "width": 640, "height": 480, "K": [800, 0, 319.5, 0, 801, 239.5, 0, 0, 1],
+     "dist": [0, 0, 0, 0, 0], "R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "t": [0, 0, 0]})";
+  }
+  std::string text(kValidRig);
+  const auto begin = text.find('[', text.find("\"cameras\"")) + 1;
+  const auto end = text.find("\n  ],\n  \"projectors\"");
+  text.replace(begin, end - begin, cameras);
+  expectRejected(text, "cameras", {"at most 16 cameras", "got 17"});
+}
+
+// Ids name output files and reach terminals: a name from a small alphabet, never a path.
+TEST(RigJsonErrors, IdsAreNamesNotPaths) {
+  expectRejected(validRigWith("\"id\": \"cam1\"", "\"id\": \"../../etc/passwd\""), "cameras[1].id",
+                 {"must start with a letter or digit"});
+  expectRejected(validRigWith("\"id\": \"cam1\"", "\"id\": \"/tmp/x\""), "cameras[1].id",
+                 {"must start with a letter or digit"});
+  expectRejected(validRigWith("\"id\": \"proj0\"", "\"id\": \"p/../../x\""), "projectors[0].id",
+                 {"has a character that is not allowed"});
+  expectRejected(validRigWith("\"id\": \"proj0\"", "\"id\": \"p0.png\\u0000\""), "projectors[0].id",
+                 {"has a character that is not allowed", "\\u0000"});
+  expectRejected(validRigWith("\"id\": \"proj0\"", "\"id\": \"p\\u001b[31m\""), "projectors[0].id",
+                 {"has a character that is not allowed", "\\u001b"});
+  expectRejected(validRigWith("\"id\": \"proj0\"", "\"id\": \"" + std::string(33, 'p') + "\""),
+                 "projectors[0].id", {"is 33 characters long"});
+  // The longest id and every allowed character are fine.
+  const auto ok =
+      parseRig(validRigWith("\"id\": \"proj0\"", "\"id\": \"Aa0_-." + std::string(26, 'z') + "\""));
+  EXPECT_TRUE(ok.has_value()) << ok.error().message();
+}
+
 TEST(RigJsonErrors, CameraMatrixMustHaveTheOpenCvStructure) {
   const std::string k = "1610.5, 0, 640.25, 0, 1611.5, 479.75, 0, 0, 1";
   expectRejected(validRigWith(k, "-1610.5, 0, 640.25, 0, 1611.5, 479.75, 0, 0, 1"),

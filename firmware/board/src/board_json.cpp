@@ -258,6 +258,16 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
     } else {
       out.rig = std::move(*rig);
     }
+    // The device streams every camera at the size its capabilities announce.
+    for (const auto& camera : out.rig.cameras) {
+      const auto& first = out.rig.cameras.front();
+      if (r.ok() && (camera.width != first.width || camera.height != first.height)) {
+        r.fail("rig", "the cameras of a board share one image size; " + camera.id + " is " +
+                          std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                          ", " + first.id + " " + std::to_string(first.width) + "x" +
+                          std::to_string(first.height));
+      }
+    }
   }
   r.number(doc, "", "depth_unit_m", Range::kPositive, board.depthUnitM);
   if (r.ok() && (board.depthUnitM < 1e-6 || board.depthUnitM > 1e-2)) {

@@ -1,0 +1,82 @@
+// The host tool against a hostile device: devices are unauthenticated and discovery can be
+// spoofed, so whatever a device sends (ids, names, frames) is input like any file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "cli_harness.hpp"
+#include "fake_device.hpp"
+#include "source_dir.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string exampleRigWith(const std::string& from, const std::string& to) {
+  std::ifstream in(smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test bug: " << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+class CliHostileDevice : public test::CliTest {};
+
+// Given a device whose rig names its camera "../../<name>", when `stream` runs, then it refuses
+// the device's rig naming the field and writes nothing, inside or outside the output folder
+// (not <name>_0.depth.png two folders up, with exit 0).
+TEST_F(CliHostileDevice, CameraIdThatIsAPathIsRefusedAndNothingIsWritten) {
+  const auto work = dir_ / "a" / "b";
+  fs::create_directories(work);
+  const std::string escaped = "smx_hostile_device_escaped";
+  test::FakeDevice device({.board = "fake",
+                           .firmwareVersion = "0.0.0",
+                           .rigJson = exampleRigWith("\"cam0\"", "\"../../" + escaped + "\""),
+                           .width = 640,
+                           .height = 480,
+                           .framesPerStart = 2});
+  const auto result = test::runCli({"stream", "--device", device.address(), "--out",
+                                    (work / "out").string(), "--frames", "1", "--timeout", "10"});
+  EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
+  EXPECT_NE(result.err.find("cameras[0].id"), std::string::npos) << result.err;
+  // out/../../ is dir_/a.
+  EXPECT_FALSE(fs::exists(dir_ / "a" / (escaped + "_0.depth.png")));
+  EXPECT_FALSE(fs::exists(work / "out"));
+}
+
+// Given a device whose board name and firmware version carry terminal escape sequences (a title
+// change, a screen clear), when `info` and `stream` print them, then no escape byte reaches the
+// terminal: each is shown as \x1b.
+TEST_F(CliHostileDevice, EscapeSequencesFromTheDeviceNeverReachTheTerminal) {
+  for (const std::string command : {"info", "stream"}) {
+    test::FakeDevice device({.board = "evil\x1b]0;owned\x07\xc2\x9b"
+                                      "2J",
+                             .firmwareVersion = "\x1b[2J1.0",
+                             .rigJson = exampleRigWith("", ""),
+                             .width = 640,
+                             .height = 480,
+                             .framesPerStart = 2});
+    std::vector<std::string> args = {command, "--device", device.address()};
+    if (command == "stream") {
+      args.insert(args.end(),
+                  {"--out", (dir_ / "out").string(), "--frames", "1", "--timeout", "10"});
+    }
+    const auto result = test::runCli(args);
+    EXPECT_EQ(result.code, kExitOk) << command << ": " << result.err;
+    const std::string printed = result.out + result.err;
+    EXPECT_EQ(printed.find('\x1b'), std::string::npos) << command << ": " << printed;
+    EXPECT_EQ(printed.find('\x07'), std::string::npos) << command;
+    EXPECT_EQ(printed.find("\xc2\x9b"), std::string::npos) << command;
+    EXPECT_NE(printed.find("evil\\x1b]0;owned\\x07\\xc2\\x9b2J"), std::string::npos)
+        << command << ": " << printed;
+  }
+}
+
+}  // namespace
+}  // namespace smx::host
