@@ -71,6 +71,18 @@ TEST(SimIo, TruncatedOrForeignPfmIsRejectedWithTheFileName) {
   fs::remove(path);
 }
 
+// A header that claims more than the file holds is refused before anything is allocated (a
+// 30-byte file claiming 2^31-1 squared floats used to end in std::bad_alloc).
+TEST(SimIo, PfmHeaderClaimingMoreThanTheFileIsRefusedBeforeAllocating) {
+  const auto path = tempFile("bomb.pfm");
+  std::ofstream(path) << "PF\n2147483647 2147483647\n-1.0\nxxxx";
+  const auto bomb = readPfm(path);
+  ASSERT_FALSE(bomb.has_value());
+  EXPECT_NE(bomb.error().find("the header announces 2147483647x2147483647"), std::string::npos)
+      << bomb.error();
+  fs::remove(path);
+}
+
 TEST(SimIo, GreyAndRgbPngRoundTrip) {
   std::vector<std::uint8_t> mask = {0, 255, 7, 0, 128, 255};
   const auto maskPath = tempFile("mask.png");

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <fstream>
+#include <system_error>
 
 namespace smx::sim {
 namespace {
@@ -60,6 +61,16 @@ std::expected<FloatImage, std::string> readPfm(const std::filesystem::path& path
   img.channels = magic == "PF" ? 3 : 1;
   const auto rowValues =
       static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.channels);
+  // The header's size must fit the file: a corrupt header must not allocate gigabytes.
+  std::error_code ec;
+  const auto fileBytes = std::filesystem::file_size(path, ec);
+  const auto dataBytes = fileBytes - static_cast<std::uintmax_t>(in.tellg());
+  if (ec || static_cast<std::uintmax_t>(in.tellg()) > fileBytes ||
+      rowValues > dataBytes / sizeof(float) / static_cast<std::size_t>(img.height)) {
+    return std::unexpected(path.string() + ": truncated: the header announces " +
+                           std::to_string(img.width) + "x" + std::to_string(img.height) +
+                           ", more than the file holds");
+  }
   img.values.resize(rowValues * static_cast<std::size_t>(img.height));
   for (int y = img.height - 1; y >= 0; --y) {
     in.read(reinterpret_cast<char*>(img.values.data() + static_cast<std::size_t>(y) * rowValues),
