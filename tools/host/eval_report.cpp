@@ -2,13 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <system_error>
 #include <vector>
 
+#include "output_folder.hpp"
 #include "smx/plots/plots.hpp"
 
 namespace smx::host {
@@ -56,16 +57,18 @@ std::string slug(std::string s) {
 }
 
 struct Writer {
-  fs::path dir;
+  OutputFolder& results;
   std::ostringstream md;
   std::string error;
+  std::set<std::string> written;
 
-  void plot(const std::expected<void, std::string>& written) {
-    if (!written && error.empty()) {
-      error = written.error();
+  void plot(const std::string& name, const OutputFolder::Writer& write) {
+    written.insert(name);
+    if (auto ok = error.empty() ? results.write(name, write) : std::expected<void, std::string>{};
+        !ok) {
+      error = ok.error();
     }
   }
-  [[nodiscard]] fs::path png(const std::string& name) const { return dir / "results" / name; }
   void image(const std::string& alt, const std::string& name) {
     md << "![" << alt << "](results/" << name << ")\n";
   }
@@ -133,15 +136,18 @@ struct Writer {
       bars.values[1].push_back(ratioOrNaN(s.figures.merged2, s.figures.merged2.completeness));
       bars.values[2].push_back(ratioOrNaN(s.figures.merged3, s.figures.merged3.completeness));
     }
-    plot(plots::writeBarChart(png("completeness.png"), bars));
+    plot("completeness.png", [&](const fs::path& f) { return plots::writeBarChart(f, bars); });
     image("completeness per scene", "completeness.png");
     md << "\n### Depth error maps\n\n"
           "Merged depth − truth, ±2 mm full scale (blue nearer, red farther); grey: no depth.\n\n";
     for (const auto& s : r.scenes) {
       const std::string name = "error_" + slug(s.scene) + "_" + slug(s.rigFile) + "_cam" +
                                std::to_string(s.camera) + ".png";
-      plot(plots::writeErrorMap(png(name), s.errorMm, s.width, s.height, 2.0,
-                                s.scene + ", " + s.rigFile + ", cam" + std::to_string(s.camera)));
+      plot(name, [&](const fs::path& f) {
+        return plots::writeErrorMap(
+            f, s.errorMm, s.width, s.height, 2.0,
+            s.scene + ", " + s.rigFile + ", cam" + std::to_string(s.camera));
+      });
       image(s.scene + " error map", name);
     }
     md << "\n";
@@ -186,7 +192,8 @@ struct Writer {
         chart.series[1].x.push_back(f.distanceM);
         chart.series[1].y.push_back(f.score.rmseMm);
       }
-      plot(plots::writeLineChart(png("error_vs_distance.png"), chart));
+      plot("error_vs_distance.png",
+           [&](const fs::path& f) { return plots::writeLineChart(f, chart); });
       md << "\n";
       image("error vs distance", "error_vs_distance.png");
     }
@@ -232,7 +239,8 @@ struct Writer {
           "epipolar lines, and decodes little or wrongly there (the pairs below); those pairs "
           "also carry most of the gross errors. Completeness follows the model more closely, "
           "because each added station brings its own pair.\n\n";
-    plot(plots::writeBarChart(png("table2_completeness.png"), chart));
+    plot("table2_completeness.png",
+         [&](const fs::path& f) { return plots::writeBarChart(f, chart); });
     md << "\n";
     image("Table 2 completeness", "table2_completeness.png");
     md << "\nPairs that delivered depth (camera–projector: inlier pixels / pixels the projector "
@@ -367,7 +375,7 @@ struct Writer {
          << (unusable.empty() ? "Usable over the whole range." : "Not usable at: " + unusable + ".")
          << "\n";
       const std::string name = "sweep_" + slug(s.name) + ".png";
-      plot(plots::writeLineChart(png(name), chart));
+      plot(name, [&](const fs::path& f) { return plots::writeLineChart(f, chart); });
       md << "\n";
       image("sweep " + s.name, name);
       md << "\n";
@@ -375,27 +383,32 @@ struct Writer {
   }
 };
 
+// Plots of an earlier run that this one did not make must not linger; other files stay.
+void removeStalePlots(const fs::path& results, const std::set<std::string>& written) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(results, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() == ".png" && !written.contains(name) &&
+        (name.starts_with("error_") || name.starts_with("sweep_") || name.starts_with("table2") ||
+         name == "completeness.png")) {
+      fs::remove(entry.path(), ec);
+    }
+  }
+}
+
 }  // namespace
 
 std::expected<void, std::string> writeEvalReport(const fs::path& dir, const eval::Report& report,
                                                  const std::string& command) {
-  Writer w{dir, {}, {}};
-  std::error_code ec;
-  fs::create_directories(dir / "results", ec);
-  if (!ec) {
-    // Plots of an earlier run that this one does not make must not linger; other files stay.
-    for (const auto& entry : fs::directory_iterator(dir / "results", ec)) {
-      const std::string name = entry.path().filename().string();
-      if (entry.path().extension() == ".png" &&
-          (name.starts_with("error_") || name.starts_with("sweep_") || name.starts_with("table2") ||
-           name == "completeness.png")) {
-        fs::remove(entry.path(), ec);
-      }
-    }
+  auto top = OutputFolder::create(dir);
+  if (!top) {
+    return std::unexpected(top.error());
   }
-  if (ec) {
-    return std::unexpected("cannot create " + (dir / "results").string() + ": " + ec.message());
+  auto results = OutputFolder::create(dir / "results");
+  if (!results) {
+    return std::unexpected(results.error());
   }
+  Writer w{*results, {}, {}, {}};
   w.md << "# stripemux: evaluation results\n\n"
           "Measured on the simulator's renders with the firmware's own per-frame pipeline. "
           "Regenerate with\n\n```\n"
@@ -416,12 +429,14 @@ std::expected<void, std::string> writeEvalReport(const fs::path& dir, const eval
   if (!w.error.empty()) {
     return std::unexpected(w.error);
   }
-  std::ofstream out(dir / "results.md");
-  out << w.md.str();
-  if (!out) {
-    return std::unexpected("cannot write " + (dir / "results.md").string());
+  if (auto ok = top->writeText("results.md", w.md.str()); !ok) {
+    return ok;
   }
-  return {};
+  if (auto ok = results->commit(); !ok) {
+    return ok;
+  }
+  removeStalePlots(results->path(), w.written);
+  return top->commit();
 }
 
 }  // namespace smx::host
