@@ -87,10 +87,11 @@ void FakeDevice::serve() {
       if (!next) {
         continue;  // skipped by the parser
       }
-      if (!next->has_value()) {
+      const std::optional<protocol::Message>& parsed = *next;
+      if (!parsed.has_value()) {
         break;
       }
-      const protocol::Message& message = **next;
+      const protocol::Message& message = *parsed;
       std::optional<protocol::ProtocolResult<std::span<const std::byte>>> reply;
       switch (message.type) {
         case protocol::MessageType::kHello: {

@@ -34,8 +34,11 @@ std::expected<std::vector<CameraImage>, std::string> parseCameraImages(
     }
     for (const auto& earlier : out) {
       if (earlier.camera == *index) {
-        return std::unexpected("--image " + spec + ": camera " + id + " already has an image (" +
-                               earlier.file.string() + "); give one --image per camera");
+        std::string message = "--image " + spec;
+        message += ": camera " + id;
+        message += " already has an image (" + earlier.file.string();
+        message += "); give one --image per camera";
+        return std::unexpected(message);
       }
     }
     const std::filesystem::path file = spec.substr(eq + 1);

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "smx/net/discovery.hpp"
+#include "terminal_text.hpp"
 
 namespace smx::host {
 
@@ -43,7 +44,9 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
     } else {
       io.out << "\n";
       for (const auto& device : *found) {
-        io.out << "  " << device.address << "  board " << device.board << "\n";
+        // Discovery answers are unauthenticated: a spoofed one must not steer the terminal.
+        io.out << "  " << printable(device.address) << "  board " << printable(device.board)
+               << "\n";
       }
     }
   }

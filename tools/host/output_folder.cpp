@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <ranges>
 #include <system_error>
 #include <utility>
 
@@ -107,8 +108,8 @@ OutputFolder::~OutputFolder() {
     fs::remove(file.temporary, ec);
   }
   // Only empty folders go: remove() refuses the others, and whatever is in them stays.
-  for (auto it = created_.rbegin(); it != created_.rend(); ++it) {
-    if (!fs::is_empty(*it, ec) || !fs::remove(*it, ec)) {
+  for (const auto& folder : std::ranges::reverse_view(created_)) {
+    if (!fs::is_empty(folder, ec) || !fs::remove(folder, ec)) {
       break;
     }
   }
