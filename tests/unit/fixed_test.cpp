@@ -87,19 +87,33 @@ static_assert(std::is_trivially_copyable_v<Q1p14>);
 // that an ill-formed expression makes the requires-expression false rather than the program
 // ill-formed.)
 template <class A, class B>
-constexpr bool kCanAdd = requires(A a, B b) { a + b; };
+constexpr bool kCanAdd = requires(A a, B b) {
+  a + b;
+};
 template <class A, class B>
-constexpr bool kCanMultiply = requires(A a, B b) { a* b; };
+constexpr bool kCanMultiply = requires(A a, B b) {
+  a* b;
+};
 template <class A, class B>
-constexpr bool kCanCompareEqual = requires(A a, B b) { a == b; };
+constexpr bool kCanCompareEqual = requires(A a, B b) {
+  a == b;
+};
 template <class A, class B>
-constexpr bool kCanCompareLess = requires(A a, B b) { a < b; };
+constexpr bool kCanCompareLess = requires(A a, B b) {
+  a < b;
+};
 template <class To, class From>
-constexpr bool kCanStaticCast = requires(From f) { static_cast<To>(f); };
+constexpr bool kCanStaticCast = requires(From f) {
+  static_cast<To>(f);
+};
 template <class A, class B>
-constexpr bool kCanAddSat = requires(A a, B b) { addSat(a, b); };
+constexpr bool kCanAddSat = requires(A a, B b) {
+  addSat(a, b);
+};
 template <class T>
-constexpr bool kCanShiftWithoutRounding = requires(T v) { roundingShiftRight(v, 1); };
+constexpr bool kCanShiftWithoutRounding = requires(T v) {
+  roundingShiftRight(v, 1);
+};
 
 static_assert(!kCanAdd<Q1p14, int> && !kCanAdd<int, Q1p14> && !kCanAdd<Q1p14, double>);
 static_assert(!kCanMultiply<Q1p14, double> && !kCanMultiply<double, Q1p14>);
