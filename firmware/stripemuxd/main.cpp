@@ -28,6 +28,7 @@ struct Options {
   int fps = 0;
   std::uint64_t frames = 0;
   double statusEveryS = 5;
+  double idleTimeoutS = 30;  // DeviceOptions::idleTimeoutNs says why
 };
 
 // SIGTERM and SIGINT are blocked in every thread and taken here, so the loops see a plain
@@ -82,6 +83,7 @@ int run(const Options& opts) {
   }
   smx::device::DeviceOptions options;
   options.firmwareVersion = SMX_VERSION;
+  options.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
   auto device = Device::create(*board, (*hal)->hal(), options);
   if (!device) {
     std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), device.error().c_str());
@@ -155,6 +157,10 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--frames", opts.frames, "stop after this many captures (0: run until SIGTERM)");
   app.add_option("--status-every", opts.statusEveryS, "seconds between status lines")
       ->check(CLI::PositiveNumber);
+  app.add_option("--idle-timeout", opts.idleTimeoutS,
+                 "seconds a host may send nothing (not streaming) or read nothing before it is "
+                 "disconnected (default 30; 0: never)")
+      ->check(CLI::Range(0.0, 86400.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

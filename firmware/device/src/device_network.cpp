@@ -92,7 +92,7 @@ void Device::dropConnection() {
   queue_.clear();
 }
 
-void Device::pumpSend() {
+void Device::pumpSend(std::int64_t nowNs) {
   while (hal_.link.connected()) {
     if (sending_.empty()) {
       sent_ = 0;
@@ -103,9 +103,11 @@ void Device::pumpSend() {
         sending_ = queue_.beginSend();
         sendingFrame_ = !sending_.empty();
         if (sending_.empty()) {
+          lastSentNs_ = nowNs;  // nothing waits: not stalled
           return;
         }
       } else {
+        lastSentNs_ = nowNs;
         return;
       }
     }
@@ -117,6 +119,7 @@ void Device::pumpSend() {
     if (*n == 0) {
       return;  // the host is not reading: the queue absorbs (and drops) what capture makes
     }
+    lastSentNs_ = nowNs;
     sent_ += *n;
     if (sent_ < sending_.size()) {
       continue;
@@ -145,6 +148,7 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       hadClient_ = true;
       parser_.reset();
       helloSeen_ = false;
+      lastReceivedNs_ = lastSentNs_ = hal_.clock.nowNs();
       ++counters_.connections;
     }
     return;
@@ -153,10 +157,14 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       !sending_.empty() || controlSize_ > 0 || (streaming_ && queue_.queued() > 0);
   (void)link.waitForIo(wantWrite, timeoutNs);
 
+  const std::int64_t now = hal_.clock.nowNs();
   const auto received = link.receiveSome(parser_.writable(), 0);
   if (!received) {
     dropConnection();
     return;
+  }
+  if (*received > 0) {
+    lastReceivedNs_ = now;
   }
   parser_.commit(*received);
   while (true) {
@@ -180,7 +188,22 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     }
     onMessage(*message);
   }
-  pumpSend();
+  pumpSend(now);
+  if (idle(now)) {
+    ++counters_.idleDisconnects;
+    dropConnection();
+  }
+}
+
+bool Device::idle(std::int64_t nowNs) const {
+  const std::int64_t timeout = options_.idleTimeoutNs;
+  if (timeout <= 0 || !hal_.link.connected()) {
+    return false;
+  }
+  // A streaming host need not send anything; every host must read what it is sent.
+  const bool silent = !streaming_ && nowNs - lastReceivedNs_ > timeout;
+  const bool stalled = nowNs - lastSentNs_ > timeout;
+  return silent || stalled;
 }
 
 void Device::runNetwork(const std::atomic<bool>& stop) {

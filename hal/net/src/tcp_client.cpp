@@ -12,6 +12,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "keepalive.hpp"
 #include "poll_fd.hpp"
 
 namespace smx::net {
@@ -64,7 +65,8 @@ std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& ad
   if (!fd.valid()) {
     return std::unexpected(detail::systemError("cannot create a socket"));
   }
-  if (receiveBufferBytes > 0) {  // before connect: it sets the window the device sees
+  detail::enableKeepAlive(fd.get());  // a device that lost power is noticed while streaming
+  if (receiveBufferBytes > 0) {       // before connect: it sets the window the device sees
     ::setsockopt(fd.get(), SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
   }
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&target), sizeof target) != 0) {
