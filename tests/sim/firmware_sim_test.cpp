@@ -443,5 +443,53 @@ TEST_F(FirmwareSim, AStreamingHostIsKeptWhileItReadsAndDroppedWhenItStops) {
   EXPECT_TRUE(host.closedByDevice(5s));
 }
 
+// Given a first host that made the device drop frames and sent a bad message, when a second
+// host streams three captures and stops, then its statistics count its own connection: the
+// three frames it received, nothing dropped, no protocol error.
+TEST_F(FirmwareSim, StatisticsCountTheHostsOwnConnection) {
+  RunningDevice running(1);
+  {
+    RawHost first(running.address());
+    first.helloAndStart();
+    std::array<std::byte, 64> out{};
+    first.send(protocol::encodeEmpty(protocol::MessageType::kCapabilities, out));  // not for it
+    while (!running.device->streaming()) {
+      std::this_thread::sleep_for(1ms);
+    }
+    for (int i = 0; i < 25; ++i) {  // the host reads nothing: frames are dropped
+      ASSERT_TRUE(running.device->captureOnce().has_value());
+    }
+  }
+  ASSERT_GT(running.device->framesDropped(), 0U);
+  ASSERT_GT(running.device->counters().protocolErrors, 0U);
+
+  auto second = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(second.has_value()) << second.error();
+  ASSERT_TRUE(second->startStream(protocol::Compression::kRvl).has_value());
+  while (!running.device->streaming()) {
+    std::this_thread::sleep_for(1ms);
+  }
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value());
+  }
+  int received = 0;
+  std::optional<protocol::Statistics> stats;
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (!stats && std::chrono::steady_clock::now() < deadline) {
+    auto event = second->next(200ms);
+    ASSERT_TRUE(event.has_value()) << event.error();
+    if (event->kind == host::DeviceEvent::Kind::kFrame && ++received == 3) {
+      ASSERT_TRUE(second->stopStream().has_value());
+    } else if (event->kind == host::DeviceEvent::Kind::kStatistics) {
+      stats = event->statistics;
+    }
+  }
+  ASSERT_TRUE(stats.has_value());
+  EXPECT_EQ(stats->framesSent, 3U);
+  EXPECT_EQ(stats->framesDropped, 0U);
+  EXPECT_EQ(stats->protocolErrors, 0U);
+  EXPECT_EQ(stats->framesDecoded, 28U);  // the device's own work counts since start-up
+}
+
 }  // namespace
 }  // namespace smx

@@ -86,9 +86,10 @@ int runInfo(const DeviceOptions& opts, const CliStreams& io) {
       auto event = client->next(std::chrono::milliseconds(200));
       if (event && event->kind == DeviceEvent::Kind::kStatistics) {
         const auto& s = event->statistics;
+        // Sent and dropped count this connection's frames (none here): not shown.
         io.out << "  up:          " << static_cast<double>(s.uptimeMs) / 1000.0 << " s, "
                << s.framesCaptured << " frames captured, " << s.framesDecoded << " decoded, "
-               << s.framesSent << " sent, " << s.framesDropped << " dropped\n";
+               << s.captureErrors << " capture errors\n";
         break;
       }
     }

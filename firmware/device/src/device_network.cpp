@@ -24,6 +24,14 @@ protocol::Statistics Device::statistics() const {
           static_cast<std::uint32_t>(decoded == 0 ? 0 : counters_.decodeTimeUsTotal / decoded)};
 }
 
+protocol::Statistics Device::statisticsForHost() const {
+  protocol::Statistics stats = statistics();
+  stats.framesSent -= sentAtConnect_;
+  stats.framesDropped -= droppedAtConnect_;
+  stats.protocolErrors -= protocolErrorsAtConnect_;
+  return stats;
+}
+
 void Device::sendControl(std::span<const std::byte> message) {
   if (control_.size() - controlSize_ < message.size()) {
     ++counters_.protocolErrors;  // a host that asks faster than it reads loses replies
@@ -70,7 +78,7 @@ void Device::onMessage(const protocol::Message& message) {
     case MessageType::kGetStatistics:
       if (!protocol::decodeEmpty(message.payload)) {
         refuse(protocol::ErrorCode::kBadRequest, "payload on a message that has none");
-      } else if (const auto stats = protocol::encode(statistics(), reply)) {
+      } else if (const auto stats = protocol::encode(statisticsForHost(), reply)) {
         sendControl(*stats);
       }
       return;
@@ -149,6 +157,9 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       parser_.reset();
       helloSeen_ = false;
       lastReceivedNs_ = lastSentNs_ = hal_.clock.nowNs();
+      sentAtConnect_ = counters_.framesSent;
+      droppedAtConnect_ = queue_.dropped();
+      protocolErrorsAtConnect_ = counters_.protocolErrors;
       ++counters_.connections;
     }
     return;
@@ -213,7 +224,7 @@ void Device::runNetwork(const std::atomic<bool>& stop) {
   if (hal_.link.connected()) {
     // Say goodbye with the counters, as far as the socket takes them now.
     std::array<std::byte, 256> reply{};
-    if (const auto stats = protocol::encode(statistics(), reply)) {
+    if (const auto stats = protocol::encode(statisticsForHost(), reply)) {
       (void)hal_.link.sendSome(*stats);
     }
     hal_.link.disconnect();

@@ -69,7 +69,11 @@ class Device {
 
   [[nodiscard]] const DeviceCounters& counters() const { return counters_; }
   [[nodiscard]] std::uint64_t framesDropped() const { return queue_.dropped(); }
+  // Since start-up, every host together (the daemon's status line).
   [[nodiscard]] protocol::Statistics statistics() const;
+  // What the connected host is sent: frames sent and dropped and protocol errors count for its
+  // connection only, the rest since start-up (docs/protocol.md, message 7).
+  [[nodiscard]] protocol::Statistics statisticsForHost() const;
   [[nodiscard]] bool streaming() const { return streaming_; }
   [[nodiscard]] std::size_t arenaBytes() const;
   [[nodiscard]] const hal::Hal& hal() const { return hal_; }
@@ -117,6 +121,10 @@ class Device {
   bool hadClient_ = false;
   std::int64_t lastReceivedNs_ = 0;  // the host last sent bytes
   std::int64_t lastSentNs_ = 0;      // the socket last took bytes, or nothing was waiting
+  // The counters when this host connected: statisticsForHost() reports what happened since.
+  std::uint64_t sentAtConnect_ = 0;
+  std::uint64_t droppedAtConnect_ = 0;
+  std::uint64_t protocolErrorsAtConnect_ = 0;
 };
 
 }  // namespace smx::device
