@@ -7,7 +7,6 @@
 
 #include <cerrno>
 #include <cstdio>
-#include <ctime>
 #include <system_error>
 
 #include "keepalive.hpp"
@@ -33,12 +32,6 @@ bool setNonBlocking(int fd) {
 
 bool peerGone(int err) {
   return err == EPIPE || err == ECONNRESET || err == ENOTCONN;
-}
-
-std::int64_t monotonicNs() {
-  timespec now{};
-  ::clock_gettime(CLOCK_MONOTONIC, &now);
-  return std::int64_t{now.tv_sec} * 1'000'000'000 + now.tv_nsec;
 }
 
 // Reads and discards what the peer sent; false once it closed or failed.
@@ -98,7 +91,7 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
   if (client_.valid()) {
     return halFail(HalErrc::kInvalidState, "a host is already connected");
   }
-  closeRefused(monotonicNs());
+  closeRefused(detail::monotonicNs());
   pollfd fd{.fd = listener_.get(), .events = POLLIN, .revents = 0};
   const int ready = detail::pollRetry(&fd, 1, timeoutNs);
   if (ready < 0) {
@@ -124,13 +117,13 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
     ::setsockopt(client.get(), SOL_SOCKET, SO_SNDBUF, &sendBufferBytes_, sizeof sendBufferBytes_);
   }
   detail::formatAddress(peer, clientAddress_);
-  clientSinceNs_ = monotonicNs();
+  clientSinceNs_ = detail::monotonicNs();
   client_ = std::move(client);
   return {};
 }
 
 void TcpLink::refusePending() {
-  const std::int64_t now = monotonicNs();
+  const std::int64_t now = detail::monotonicNs();
   while (true) {
     UniqueFd extra(::accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
     if (!extra.valid()) {
@@ -211,7 +204,7 @@ hal::HalResult<std::size_t> TcpLink::receiveSome(std::span<std::byte> bytes,
 }
 
 hal::HalResult<void> TcpLink::waitForIo(bool wantWrite, std::int64_t timeoutNs) {
-  closeRefused(monotonicNs());
+  closeRefused(detail::monotonicNs());
   const short clientEvents = wantWrite ? POLLIN | POLLOUT : POLLIN;
   pollfd fds[2] = {{.fd = listener_.get(), .events = POLLIN, .revents = 0},
                    {.fd = client_.get(), .events = clientEvents, .revents = 0}};
