@@ -14,6 +14,7 @@
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/discovery.hpp"
+#include "smx/net/tcp_client.hpp"
 
 namespace {
 
@@ -97,8 +98,8 @@ int run(const Options& opts) {
       rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
       rig.projectors.size(), (*device)->arenaBytes() / 1024);
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
-  std::printf("listening on %s:%u\n", config.network.bindAddress.c_str(),
-              static_cast<unsigned>(tcpPort));
+  std::printf("listening on %s\n",
+              smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
   // Discovery is a convenience: a second device on this machine (tests) goes without it.
   auto discovery = smx::net::DiscoveryResponder::create(
       config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
@@ -148,7 +149,9 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--board", opts.board, "board folder or board.json (boards/<name>)")->required();
   app.add_option("--port", opts.port, "TCP port (overrides the board; 0: any free port)")
       ->check(CLI::Range(0, 65535));
-  app.add_option("--bind", opts.bind, "IPv4 address to listen on (overrides the board)");
+  app.add_option("--bind", opts.bind,
+                 "IPv4 or IPv6 address to listen on (overrides the board; \"::\": every "
+                 "address, IPv4 too)");
   app.add_option("--scene", opts.scene, "simulated board: render this scene");
   app.add_option("--replay", opts.replay,
                  "simulated board: replay <dir>/<camera-id>_<n>.png instead of rendering");

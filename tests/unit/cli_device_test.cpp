@@ -16,7 +16,8 @@ class CliDevice : public test::CliTest {};
 // (exit 1, docs/cli.md) naming the bad address, and no connection is tried.
 TEST_F(CliDevice, AMalformedDeviceAddressIsAUsageError) {
   const std::string out = (dir_ / "out").string();
-  for (const std::string bad : {"10.0.0.2:99999", "10.0.0.2:", "10.0.0.2:port", ":5555"}) {
+  for (const std::string bad :
+       {"10.0.0.2:99999", "10.0.0.2:", "10.0.0.2:port", ":5555", "[::1", "[::1]:", "[::1]:0"}) {
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"info", "--device", bad},
           std::vector<std::string>{"stream", "--device", bad, "--out", out}}) {

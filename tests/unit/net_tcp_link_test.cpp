@@ -159,5 +159,33 @@ TEST(TcpLink, BothEndsOfAConnectionProbeWithKeepalive) {
   EXPECT_EQ(timers.hostEnd, 2) << "the host's end of the connection has no keepalive";
 }
 
+// Given a link listening on every address ("::"), when a host connects over IPv6 loopback with
+// TcpClient, then it is served, and an IPv4 host that comes second is told the IPv6 holder.
+TEST(TcpLink, ServesIpv6HostsAndIpv4OnesOnEveryAddress) {
+  hal::NetworkConfig network;
+  network.bindAddress = "::";
+  network.port = 0;
+  auto link = TcpLink::create(network);
+  ASSERT_TRUE(link.has_value()) << link.error();
+  auto client = TcpClient::connect({"::1", (*link)->port()}, 2000ms);
+  if (!client && client.error().find("Cannot assign") != std::string::npos) {
+    GTEST_SKIP() << "no IPv6 loopback: " << client.error();
+  }
+  ASSERT_TRUE(client.has_value()) << client.error();
+  ASSERT_TRUE((*link)->acceptClient(2'000'000'000).has_value());
+
+  std::uint16_t secondPort = 0;
+  const UniqueFd second = connectRaw((*link)->port(), secondPort);
+  const auto deadline = Clock::now() + 5s;
+  while ((*link)->refusedClients() == 0 && Clock::now() < deadline) {
+    ASSERT_TRUE((*link)->waitForIo(false, 10'000'000).has_value());
+  }
+  const auto reply = readMessage(second.get());
+  ASSERT_TRUE(reply.has_value());
+  const auto error = protocol::decodeError(reply->second);
+  ASSERT_TRUE(error.has_value());
+  EXPECT_NE(std::string(error->text).find("held by [::1]:"), std::string::npos) << error->text;
+}
+
 }  // namespace
 }  // namespace smx::net

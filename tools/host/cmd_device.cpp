@@ -43,7 +43,8 @@ struct StreamOptions {
 };
 
 bool isLoopback(const std::string& address) {
-  return address.starts_with("127.") || address.starts_with("localhost");
+  return address.starts_with("127.") || address.starts_with("localhost") ||
+         address.starts_with("[::1]");
 }
 
 std::string describe(const DeviceInfo& info) {

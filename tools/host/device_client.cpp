@@ -45,7 +45,7 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
   if (!parsed) {
     return Fail("--device: " + parsed.error());
   }
-  const std::string where = parsed->host + ":" + std::to_string(parsed->port);
+  const std::string where = net::toString(*parsed);
   auto socket = net::TcpClient::connect(*parsed, timeout, kReceiveBufferBytes);
   if (!socket) {
     return Fail(socket.error());

@@ -47,7 +47,9 @@ std::expected<sockaddr_in, std::string> ipv4(const std::string& host, std::uint1
 std::expected<std::unique_ptr<DiscoveryResponder>, std::string> DiscoveryResponder::create(
     const std::string& bindAddress, std::uint16_t udpPort, std::uint16_t tcpPort,
     const std::string& board) {
-  auto address = ipv4(bindAddress, udpPort);
+  // Discovery is IPv4 (broadcast): a device listening on every IPv6 address ("::") answers on
+  // every IPv4 one.
+  auto address = ipv4(bindAddress == "::" ? "0.0.0.0" : bindAddress, udpPort);
   if (!address) {
     return Fail("discovery: " + address.error());
   }
