@@ -55,7 +55,12 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
       client.send(protocol::encode(protocol::Hello{"stripemux " SMX_VERSION}, client.out_));
   // A busy device closes at once; its error may be waiting even when the hello failed.
   auto reply = client.nextMessage(hello ? timeout : std::min(timeout, kRefusalWait));
-  if (!hello && !(reply && reply->has_value() && (*reply)->first == MessageType::kError)) {
+  bool refused = false;
+  if (reply) {
+    const auto& answer = *reply;
+    refused = answer.has_value() && answer->first == MessageType::kError;
+  }
+  if (!hello && !refused) {
     return Fail(where + ": " + hello.error());
   }
   if (!reply) {

@@ -55,14 +55,13 @@ std::expected<DeviceAddress, std::string> parseDeviceAddress(const std::string& 
       portText = rest.substr(1);
       hasPort = true;
     }
-  } else if (std::ranges::count(text, ':') > 1) {
-    host = text;  // a bare IPv6 address
-  } else if (const auto colon = text.find(':'); colon != std::string::npos) {
+  } else if (std::ranges::count(text, ':') == 1) {
+    const auto colon = text.find(':');
     host = text.substr(0, colon);
     portText = text.substr(colon + 1);
     hasPort = true;
   } else {
-    host = text;
+    host = text;  // a name, an IPv4 address or a bare IPv6 address (two colons or more)
   }
   if (host.empty() || host.find_first_of("[]") != std::string::npos) {
     return bad();

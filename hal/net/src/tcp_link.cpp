@@ -140,15 +140,17 @@ void TcpLink::refusePending() {
       (void)::send(extra.get(), busy->data(), busy->size(), MSG_NOSIGNAL | MSG_DONTWAIT);
     }
     ::shutdown(extra.get(), SHUT_WR);
-    for (Refused& slot : refusedOpen_) {
-      if (!slot.fd.valid()) {
-        slot = Refused{std::move(extra), now + kRefusedLingerNs};
+    Refused* slot = nullptr;
+    for (Refused& candidate : refusedOpen_) {
+      if (!candidate.fd.valid()) {
+        slot = &candidate;
         break;
       }
     }
-    // No slot free (a burst of hosts): `extra` closes here, after what it sent is drained.
-    if (extra.valid()) {
-      (void)drain(extra.get());
+    if (slot != nullptr) {
+      *slot = Refused{std::move(extra), now + kRefusedLingerNs};
+    } else {
+      (void)drain(extra.get());  // a burst of hosts: this one closes now, what it sent read first
     }
   }
 }
