@@ -14,6 +14,7 @@
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/discovery.hpp"
+#include "smx/net/tcp_client.hpp"
 
 namespace {
 
@@ -28,6 +29,7 @@ struct Options {
   int fps = 0;
   std::uint64_t frames = 0;
   double statusEveryS = 5;
+  double idleTimeoutS = 30;  // DeviceOptions::idleTimeoutNs says why
 };
 
 // SIGTERM and SIGINT are blocked in every thread and taken here, so the loops see a plain
@@ -82,6 +84,7 @@ int run(const Options& opts) {
   }
   smx::device::DeviceOptions options;
   options.firmwareVersion = SMX_VERSION;
+  options.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
   auto device = Device::create(*board, (*hal)->hal(), options);
   if (!device) {
     std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), device.error().c_str());
@@ -95,8 +98,8 @@ int run(const Options& opts) {
       rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
       rig.projectors.size(), (*device)->arenaBytes() / 1024);
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
-  std::printf("listening on %s:%u\n", config.network.bindAddress.c_str(),
-              static_cast<unsigned>(tcpPort));
+  std::printf("listening on %s\n",
+              smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
   // Discovery is a convenience: a second device on this machine (tests) goes without it.
   auto discovery = smx::net::DiscoveryResponder::create(
       config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
@@ -146,7 +149,9 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--board", opts.board, "board folder or board.json (boards/<name>)")->required();
   app.add_option("--port", opts.port, "TCP port (overrides the board; 0: any free port)")
       ->check(CLI::Range(0, 65535));
-  app.add_option("--bind", opts.bind, "IPv4 address to listen on (overrides the board)");
+  app.add_option("--bind", opts.bind,
+                 "IPv4 or IPv6 address to listen on (overrides the board; \"::\": every "
+                 "address, IPv4 too)");
   app.add_option("--scene", opts.scene, "simulated board: render this scene");
   app.add_option("--replay", opts.replay,
                  "simulated board: replay <dir>/<camera-id>_<n>.png instead of rendering");
@@ -155,6 +160,10 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--frames", opts.frames, "stop after this many captures (0: run until SIGTERM)");
   app.add_option("--status-every", opts.statusEveryS, "seconds between status lines")
       ->check(CLI::PositiveNumber);
+  app.add_option("--idle-timeout", opts.idleTimeoutS,
+                 "seconds a host may send nothing (not streaming) or read nothing before it is "
+                 "disconnected (default 30; 0: never)")
+      ->check(CLI::Range(0.0, 86400.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

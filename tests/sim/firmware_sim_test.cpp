@@ -52,11 +52,12 @@ board::Board simBoard(int cameras) {
 
 // A device on the simulated board with its network loop running.
 struct RunningDevice {
-  explicit RunningDevice(int cameras) : board(simBoard(cameras)) {
+  explicit RunningDevice(int cameras, const device::DeviceOptions& options = {})
+      : board(simBoard(cameras)) {
     auto made = hal::createBoardHal(board.config, board.rig);
     EXPECT_TRUE(made.has_value()) << made.error();
     boardHal = std::move(*made);
-    auto dev = device::Device::create(board, boardHal->hal(), {});
+    auto dev = device::Device::create(board, boardHal->hal(), options);
     EXPECT_TRUE(dev.has_value()) << dev.error();
     device = std::move(*dev);
     network = std::jthread([this] { device->runNetwork(stopNetwork); });
@@ -87,6 +88,12 @@ struct RunningDevice {
   std::jthread network;
   std::jthread capture;
 };
+
+device::DeviceOptions idleTimeout(std::int64_t ns) {
+  device::DeviceOptions options;
+  options.idleTimeoutNs = ns;
+  return options;
+}
 
 // A host that says hello, starts the stream and then only reads into one fixed buffer (or, while
 // `paused`, not at all): it allocates nothing after connect.
@@ -124,6 +131,17 @@ class RawHost {
   }
   void pause(bool paused) { paused_ = paused; }
   [[nodiscard]] std::uint64_t bytes() const { return bytes_; }
+  // Waits at most `wait` for the device to close the connection (what was sent is read).
+  [[nodiscard]] bool closedByDevice(std::chrono::milliseconds wait) {
+    std::array<std::byte, 1 << 16> sink{};
+    const auto deadline = std::chrono::steady_clock::now() + wait;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (!socket_->receiveSome(sink, 50ms)) {
+        return true;
+      }
+    }
+    return false;
+  }
   ~RawHost() { stop_ = true; }
   RawHost(const RawHost&) = delete;
   RawHost& operator=(const RawHost&) = delete;
@@ -344,6 +362,133 @@ TEST_F(FirmwareSim, GarbageFromTheHostIsCountedAndTheConnectionStaysUsable) {
   EXPECT_EQ(replies[0], protocol::MessageType::kError);  // "this device speaks version 1"
   EXPECT_EQ(replies[1], protocol::MessageType::kCapabilities);
   EXPECT_GE(running.device->counters().protocolErrors, 2U);  // the garbage and the v9 message
+}
+
+// Given a host streaming from the device, when a second host connects, then the second is told
+// the device is busy and by whom, and the first goes on receiving frames.
+TEST_F(FirmwareSim, ASecondHostIsToldTheDeviceIsBusyAndTheFirstKeepsStreaming) {
+  RunningDevice running(1);
+  running.startCapture();
+  auto first = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(first.has_value()) << first.error();
+  ASSERT_TRUE(first->startStream(protocol::Compression::kRvl).has_value());
+  const auto receive = [&](int frames) {
+    int received = 0;
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (received < frames && std::chrono::steady_clock::now() < deadline) {
+      auto event = first->next(200ms);
+      EXPECT_TRUE(event.has_value()) << event.error();
+      if (!event) {
+        return received;
+      }
+      received += event->kind == host::DeviceEvent::Kind::kFrame ? 1 : 0;
+    }
+    return received;
+  };
+  ASSERT_EQ(receive(1), 1);
+
+  const auto second = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_FALSE(second.has_value());
+  EXPECT_NE(second.error().find("the device is busy"), std::string::npos) << second.error();
+  EXPECT_NE(second.error().find("held by 127.0.0.1:"), std::string::npos) << second.error();
+
+  EXPECT_EQ(receive(2), 2) << "the first host lost its stream";
+  EXPECT_EQ(running.device->counters().connections, 1U);
+}
+
+// Given a device with a short idle timeout, when a host says hello and then nothing, then the
+// device disconnects it after the timeout, and another host is served.
+TEST_F(FirmwareSim, AHostSilentWhileNotStreamingIsDroppedAfterTheIdleTimeout) {
+  RunningDevice running(1, idleTimeout(300'000'000));
+  auto silent = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(silent.has_value()) << silent.error();
+  const auto start = std::chrono::steady_clock::now();
+  std::optional<std::string> closed;
+  while (!closed && std::chrono::steady_clock::now() - start < 5s) {
+    if (auto event = silent->next(100ms); !event) {
+      closed = event.error();
+    }
+  }
+  ASSERT_TRUE(closed.has_value()) << "a silent host still holds the device after 5 s";
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 300ms);
+  EXPECT_EQ(running.device->counters().idleDisconnects, 1U);
+
+  auto next = host::DeviceClient::connect(running.address(), 3000ms);
+  EXPECT_TRUE(next.has_value()) << next.error();
+}
+
+// Given a device with a short idle timeout, when a streaming host stops reading, then the
+// device disconnects it; a streaming host that reads but sends nothing is kept.
+TEST_F(FirmwareSim, AStreamingHostIsKeptWhileItReadsAndDroppedWhenItStops) {
+  RunningDevice running(1, idleTimeout(1'000'000'000));
+  running.startCapture();
+  RawHost host(running.address());
+  host.helloAndStart();
+  host.startDraining();
+  // Three timeouts of sending nothing while reading: still connected and receiving.
+  std::this_thread::sleep_for(3s);
+  const std::uint64_t bytesBefore = host.bytes();
+  EXPECT_GT(bytesBefore, 0U);
+  EXPECT_EQ(running.device->counters().idleDisconnects, 0U);
+
+  host.pause(true);
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (running.device->counters().idleDisconnects == 0 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(running.device->counters().idleDisconnects, 1U)
+      << "a host that reads nothing still holds the device after 10 s";
+  host.pause(false);
+  EXPECT_TRUE(host.closedByDevice(5s));
+}
+
+// Given a first host that made the device drop frames and sent a bad message, when a second
+// host streams three captures and stops, then its statistics count its own connection: the
+// three frames it received, nothing dropped, no protocol error.
+TEST_F(FirmwareSim, StatisticsCountTheHostsOwnConnection) {
+  RunningDevice running(1);
+  {
+    RawHost first(running.address());
+    first.helloAndStart();
+    std::array<std::byte, 64> out{};
+    first.send(protocol::encodeEmpty(protocol::MessageType::kCapabilities, out));  // not for it
+    while (!running.device->streaming()) {
+      std::this_thread::sleep_for(1ms);
+    }
+    for (int i = 0; i < 25; ++i) {  // the host reads nothing: frames are dropped
+      ASSERT_TRUE(running.device->captureOnce().has_value());
+    }
+  }
+  ASSERT_GT(running.device->framesDropped(), 0U);
+  ASSERT_GT(running.device->counters().protocolErrors, 0U);
+
+  auto second = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(second.has_value()) << second.error();
+  ASSERT_TRUE(second->startStream(protocol::Compression::kRvl).has_value());
+  while (!running.device->streaming()) {
+    std::this_thread::sleep_for(1ms);
+  }
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(running.device->captureOnce().has_value());
+  }
+  int received = 0;
+  std::optional<protocol::Statistics> stats;
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (!stats && std::chrono::steady_clock::now() < deadline) {
+    auto event = second->next(200ms);
+    ASSERT_TRUE(event.has_value()) << event.error();
+    if (event->kind == host::DeviceEvent::Kind::kFrame && ++received == 3) {
+      ASSERT_TRUE(second->stopStream().has_value());
+    } else if (event->kind == host::DeviceEvent::Kind::kStatistics) {
+      stats = event->statistics;
+    }
+  }
+  ASSERT_TRUE(stats.has_value());
+  EXPECT_EQ(stats->framesSent, 3U);
+  EXPECT_EQ(stats->framesDropped, 0U);
+  EXPECT_EQ(stats->protocolErrors, 0U);
+  EXPECT_EQ(stats->framesDecoded, 28U);  // the device's own work counts since start-up
 }
 
 }  // namespace

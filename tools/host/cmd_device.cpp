@@ -14,6 +14,8 @@
 #include "device_client.hpp"
 #include "output_folder.hpp"
 #include "point_cloud.hpp"
+#include "smx/net/tcp_client.hpp"
+#include "smx/protocol/wire.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "terminal_text.hpp"
@@ -42,7 +44,8 @@ struct StreamOptions {
 };
 
 bool isLoopback(const std::string& address) {
-  return address.starts_with("127.") || address.starts_with("localhost");
+  return address.starts_with("127.") || address.starts_with("localhost") ||
+         address.starts_with("[::1]");
 }
 
 std::string describe(const DeviceInfo& info) {
@@ -87,9 +90,10 @@ int runInfo(const DeviceOptions& opts, const CliStreams& io) {
       auto event = client->next(std::chrono::milliseconds(200));
       if (event && event->kind == DeviceEvent::Kind::kStatistics) {
         const auto& s = event->statistics;
+        // Sent and dropped count this connection's frames (none here): not shown.
         io.out << "  up:          " << static_cast<double>(s.uptimeMs) / 1000.0 << " s, "
                << s.framesCaptured << " frames captured, " << s.framesDecoded << " decoded, "
-               << s.framesSent << " sent, " << s.framesDropped << " dropped\n";
+               << s.captureErrors << " capture errors\n";
         break;
       }
     }
@@ -402,13 +406,23 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
+// A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
+CLI::Validator deviceAddress() {
+  return {[](const std::string& text) {
+            const auto parsed = net::parseDeviceAddress(text, protocol::kDefaultPort);
+            return parsed ? std::string() : parsed.error();
+          },
+          "HOST[:PORT]"};
+}
+
 }  // namespace
 
 void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<DeviceOptions>();
   auto* cmd = app.add_subcommand("info", "What a device reports: board, firmware, rig, counters");
   cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
-      ->required();
+      ->required()
+      ->check(deviceAddress());
   cmd->callback([opts, &io, &exitCode] { exitCode = runInfo(*opts, io); });
 }
 
@@ -417,7 +431,8 @@ void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto* cmd = app.add_subcommand(
       "stream", "Receive range images from a device: depth PNGs, PLY point clouds, a summary");
   cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
-      ->required();
+      ->required()
+      ->check(deviceAddress());
   cmd->add_option("--out", opts->out, "Output directory")->required();
   cmd->add_option("--frames", opts->frames, "Frames per camera to receive (default 10)")
       ->check(CLI::Range(1, 1000000));

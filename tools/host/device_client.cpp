@@ -1,5 +1,7 @@
 #include "device_client.hpp"
 
+#include <algorithm>
+
 #include "smx/hal/steady_clock.hpp"
 #include "smx/protocol/rig_json.hpp"
 
@@ -13,11 +15,17 @@ using protocol::MessageType;
 // About five range frames: enough to ride out a slow file write, small enough that a host that
 // keeps falling behind sees fresh frames (the device drops the oldest) rather than old ones.
 constexpr int kReceiveBufferBytes = 1 << 20;
+// How long a host whose hello could not be sent looks for the device's reason (`busy`).
+constexpr auto kRefusalWait = std::chrono::milliseconds(500);
 
 std::string deviceError(std::span<const std::byte> payload) {
   const auto error = protocol::decodeError(payload);
   if (!error) {
     return "the device reported an error (unreadable)";
+  }
+  if (error->code == protocol::ErrorCode::kBusy) {
+    return "the device is busy, " + std::string(error->text) +
+           "; it serves one host at a time: try again when that host is done";
   }
   return "the device refused: " + std::string(error->text);
 }
@@ -37,18 +45,24 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
   if (!parsed) {
     return Fail("--device: " + parsed.error());
   }
-  const std::string where = parsed->host + ":" + std::to_string(parsed->port);
+  const std::string where = net::toString(*parsed);
   auto socket = net::TcpClient::connect(*parsed, timeout, kReceiveBufferBytes);
   if (!socket) {
     return Fail(socket.error());
   }
   DeviceClient client(std::move(*socket), where);
-  if (auto hello =
-          client.send(protocol::encode(protocol::Hello{"stripemux " SMX_VERSION}, client.out_));
-      !hello) {
-    return Fail(hello.error());
+  const auto hello =
+      client.send(protocol::encode(protocol::Hello{"stripemux " SMX_VERSION}, client.out_));
+  // A busy device closes at once; its error may be waiting even when the hello failed.
+  auto reply = client.nextMessage(hello ? timeout : std::min(timeout, kRefusalWait));
+  bool refused = false;
+  if (reply) {
+    const auto& answer = *reply;
+    refused = answer.has_value() && answer->first == MessageType::kError;
   }
-  auto reply = client.nextMessage(timeout);
+  if (!hello && !refused) {
+    return Fail(where + ": " + hello.error());
+  }
   if (!reply) {
     return Fail(where + ": " + reply.error());
   }

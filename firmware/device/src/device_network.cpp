@@ -24,6 +24,14 @@ protocol::Statistics Device::statistics() const {
           static_cast<std::uint32_t>(decoded == 0 ? 0 : counters_.decodeTimeUsTotal / decoded)};
 }
 
+protocol::Statistics Device::statisticsForHost() const {
+  protocol::Statistics stats = statistics();
+  stats.framesSent -= sentAtConnect_;
+  stats.framesDropped -= droppedAtConnect_;
+  stats.protocolErrors -= protocolErrorsAtConnect_;
+  return stats;
+}
+
 void Device::sendControl(std::span<const std::byte> message) {
   if (control_.size() - controlSize_ < message.size()) {
     ++counters_.protocolErrors;  // a host that asks faster than it reads loses replies
@@ -70,7 +78,7 @@ void Device::onMessage(const protocol::Message& message) {
     case MessageType::kGetStatistics:
       if (!protocol::decodeEmpty(message.payload)) {
         refuse(protocol::ErrorCode::kBadRequest, "payload on a message that has none");
-      } else if (const auto stats = protocol::encode(statistics(), reply)) {
+      } else if (const auto stats = protocol::encode(statisticsForHost(), reply)) {
         sendControl(*stats);
       }
       return;
@@ -92,7 +100,7 @@ void Device::dropConnection() {
   queue_.clear();
 }
 
-void Device::pumpSend() {
+void Device::pumpSend(std::int64_t nowNs) {
   while (hal_.link.connected()) {
     if (sending_.empty()) {
       sent_ = 0;
@@ -103,9 +111,11 @@ void Device::pumpSend() {
         sending_ = queue_.beginSend();
         sendingFrame_ = !sending_.empty();
         if (sending_.empty()) {
+          lastSentNs_ = nowNs;  // nothing waits: not stalled
           return;
         }
       } else {
+        lastSentNs_ = nowNs;
         return;
       }
     }
@@ -117,6 +127,7 @@ void Device::pumpSend() {
     if (*n == 0) {
       return;  // the host is not reading: the queue absorbs (and drops) what capture makes
     }
+    lastSentNs_ = nowNs;
     sent_ += *n;
     if (sent_ < sending_.size()) {
       continue;
@@ -145,6 +156,10 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       hadClient_ = true;
       parser_.reset();
       helloSeen_ = false;
+      lastReceivedNs_ = lastSentNs_ = hal_.clock.nowNs();
+      sentAtConnect_ = counters_.framesSent;
+      droppedAtConnect_ = queue_.dropped();
+      protocolErrorsAtConnect_ = counters_.protocolErrors;
       ++counters_.connections;
     }
     return;
@@ -153,10 +168,14 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       !sending_.empty() || controlSize_ > 0 || (streaming_ && queue_.queued() > 0);
   (void)link.waitForIo(wantWrite, timeoutNs);
 
+  const std::int64_t now = hal_.clock.nowNs();
   const auto received = link.receiveSome(parser_.writable(), 0);
   if (!received) {
     dropConnection();
     return;
+  }
+  if (*received > 0) {
+    lastReceivedNs_ = now;
   }
   parser_.commit(*received);
   while (true) {
@@ -180,7 +199,22 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     }
     onMessage(*message);
   }
-  pumpSend();
+  pumpSend(now);
+  if (idle(now)) {
+    ++counters_.idleDisconnects;
+    dropConnection();
+  }
+}
+
+bool Device::idle(std::int64_t nowNs) const {
+  const std::int64_t timeout = options_.idleTimeoutNs;
+  if (timeout <= 0 || !hal_.link.connected()) {
+    return false;
+  }
+  // A streaming host need not send anything; every host must read what it is sent.
+  const bool silent = !streaming_ && nowNs - lastReceivedNs_ > timeout;
+  const bool stalled = nowNs - lastSentNs_ > timeout;
+  return silent || stalled;
 }
 
 void Device::runNetwork(const std::atomic<bool>& stop) {
@@ -190,7 +224,7 @@ void Device::runNetwork(const std::atomic<bool>& stop) {
   if (hal_.link.connected()) {
     // Say goodbye with the counters, as far as the socket takes them now.
     std::array<std::byte, 256> reply{};
-    if (const auto stats = protocol::encode(statistics(), reply)) {
+    if (const auto stats = protocol::encode(statisticsForHost(), reply)) {
       (void)hal_.link.sendSome(*stats);
     }
     hal_.link.disconnect();

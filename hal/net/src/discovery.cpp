@@ -21,8 +21,9 @@ namespace {
 using Fail = std::unexpected<std::string>;
 constexpr std::array<char, 5> kRequestTag = {'S', 'M', 'X', 'P', '?'};
 constexpr std::array<char, 5> kAnswerTag = {'S', 'M', 'X', 'P', '!'};
-constexpr std::byte kVersion{1};
-constexpr std::size_t kRequestBytes = kRequestTag.size() + 1;
+// Version 2: requests padded to the answer's length (version 1's 6-byte request is ignored).
+constexpr std::byte kVersion{2};
+constexpr std::int64_t kWindowNs = 1'000'000'000;
 
 bool startsWith(std::span<const std::byte> bytes, const std::array<char, 5>& tag) {
   return bytes.size() > tag.size() &&
@@ -46,7 +47,9 @@ std::expected<sockaddr_in, std::string> ipv4(const std::string& host, std::uint1
 std::expected<std::unique_ptr<DiscoveryResponder>, std::string> DiscoveryResponder::create(
     const std::string& bindAddress, std::uint16_t udpPort, std::uint16_t tcpPort,
     const std::string& board) {
-  auto address = ipv4(bindAddress, udpPort);
+  // Discovery is IPv4 (broadcast): a device listening on every IPv6 address ("::") answers on
+  // every IPv4 one.
+  auto address = ipv4(bindAddress == "::" ? "0.0.0.0" : bindAddress, udpPort);
   if (!address) {
     return Fail("discovery: " + address.error());
   }
@@ -86,7 +89,7 @@ hal::HalResult<int> DiscoveryResponder::serviceOnce(std::int64_t timeoutNs) {
     return 0;
   }
   int answered = 0;
-  std::array<std::byte, 64> request{};
+  std::array<std::byte, kDiscoveryRequestBytes + 64> request{};
   while (true) {
     sockaddr_in from{};
     socklen_t fromLength = sizeof from;
@@ -97,9 +100,14 @@ hal::HalResult<int> DiscoveryResponder::serviceOnce(std::int64_t timeoutNs) {
                  ? hal::HalResult<int>(answered)
                  : hal::halFail(hal::HalErrc::kIo, "discovery: recvfrom failed", errno);
     }
-    if (static_cast<std::size_t>(got) != kRequestBytes ||
-        !startsWith(std::span(request).first(kRequestBytes), kRequestTag)) {
+    // Never more bytes out than in: a forged source address gains nothing.
+    if (static_cast<std::size_t>(got) < answer_.size() ||
+        !startsWith(std::span(request).first(static_cast<std::size_t>(got)), kRequestTag)) {
       ++ignored_;
+      continue;
+    }
+    if (!allowReply(from.sin_addr.s_addr, detail::monotonicNs())) {
+      ++limited_;
       continue;
     }
     // A lost answer is the host's to retry: UDP.
@@ -107,6 +115,34 @@ hal::HalResult<int> DiscoveryResponder::serviceOnce(std::int64_t timeoutNs) {
                    reinterpret_cast<const sockaddr*>(&from), fromLength);
     ++answered;
   }
+}
+
+bool DiscoveryResponder::allowReply(std::uint32_t address, std::int64_t nowNs) {
+  const auto take = [nowNs](Window& window, int limit) {
+    if (nowNs - window.startNs >= kWindowNs) {
+      window = Window{nowNs, 0};
+    }
+    return window.replies < limit;
+  };
+  Source* source = &sources_.front();
+  for (Source& candidate : sources_) {
+    if (candidate.address == address) {
+      source = &candidate;
+      break;
+    }
+    if (candidate.window.startNs < source->window.startNs) {
+      source = &candidate;
+    }
+  }
+  if (source->address != address) {
+    *source = Source{address, Window{nowNs, 0}};
+  }
+  if (!take(total_, kDiscoveryRepliesTotal) || !take(source->window, kDiscoveryRepliesPerSource)) {
+    return false;
+  }
+  ++total_.replies;
+  ++source->window.replies;
+  return true;
 }
 
 std::expected<std::vector<FoundDevice>, std::string> discoverDevices(
@@ -118,10 +154,10 @@ std::expected<std::vector<FoundDevice>, std::string> discoverDevices(
   }
   const int yes = 1;
   ::setsockopt(socket.get(), SOL_SOCKET, SO_BROADCAST, &yes, sizeof yes);
-  std::array<std::byte, kRequestBytes> request{};
+  std::array<std::byte, kDiscoveryRequestBytes> request{};  // zero padding after the version
   std::transform(kRequestTag.begin(), kRequestTag.end(), request.begin(),
                  [](char c) { return static_cast<std::byte>(c); });
-  request.back() = kVersion;
+  request[kRequestTag.size()] = kVersion;
   for (const std::string& target : targets) {
     auto address = ipv4(target, udpPort);
     if (!address) {

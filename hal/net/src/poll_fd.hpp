@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <ctime>
 #include <limits>
 #include <string>
 #include <system_error>
@@ -30,6 +31,13 @@ namespace smx::net::detail {
 static_assert(EAGAIN == EWOULDBLOCK);
 [[nodiscard]] inline bool wouldBlock(int err) {
   return err == EAGAIN || err == EINTR;
+}
+
+// CLOCK_MONOTONIC in nanoseconds (the HAL's clock is not reachable from here).
+[[nodiscard]] inline std::int64_t monotonicNs() {
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return std::int64_t{now.tv_sec} * 1'000'000'000 + now.tv_nsec;
 }
 
 // Returns poll()'s result; -1 with errno on failure.

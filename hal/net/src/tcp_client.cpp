@@ -7,11 +7,14 @@
 #include <netinet/tcp.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <memory>
 #include <system_error>
 
+#include "keepalive.hpp"
 #include "poll_fd.hpp"
 
 namespace smx::net {
@@ -26,48 +29,74 @@ std::int64_t toNs(std::chrono::milliseconds timeout) {
 
 std::expected<DeviceAddress, std::string> parseDeviceAddress(const std::string& text,
                                                              std::uint16_t defaultPort) {
+  const auto bad = [&] {
+    return std::unexpected("'" + text +
+                           "' is not HOST, HOST:PORT, [IPV6] or [IPV6]:PORT with a port in "
+                           "1..65535");
+  };
   if (text.empty()) {
-    return std::unexpected("the device address is empty (expected HOST or HOST:PORT)");
+    return std::unexpected(
+        "the device address is empty (expected HOST, HOST:PORT, [IPV6] or [IPV6]:PORT)");
   }
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos) {
-    return DeviceAddress{text, defaultPort};
+  std::string host;
+  std::string portText;
+  bool hasPort = false;
+  if (text.front() == '[') {
+    const auto close = text.find(']');
+    if (close == std::string::npos || close == 1) {
+      return bad();
+    }
+    host = text.substr(1, close - 1);
+    const std::string rest = text.substr(close + 1);
+    if (!rest.empty()) {
+      if (rest.front() != ':') {
+        return bad();
+      }
+      portText = rest.substr(1);
+      hasPort = true;
+    }
+  } else if (std::ranges::count(text, ':') == 1) {
+    const auto colon = text.find(':');
+    host = text.substr(0, colon);
+    portText = text.substr(colon + 1);
+    hasPort = true;
+  } else {
+    host = text;  // a name, an IPv4 address or a bare IPv6 address (two colons or more)
   }
-  const std::string host = text.substr(0, colon);
-  const std::string portText = text.substr(colon + 1);
+  if (host.empty() || host.find_first_of("[]") != std::string::npos) {
+    return bad();
+  }
+  if (!hasPort) {
+    return DeviceAddress{host, defaultPort};
+  }
   unsigned port = 0;
   const auto [end, ec] = std::from_chars(portText.data(), portText.data() + portText.size(), port);
-  if (host.empty() || ec != std::errc{} || end != portText.data() + portText.size() || port == 0 ||
-      port > 65535) {
-    return std::unexpected("'" + text + "' is not HOST or HOST:PORT with a port in 1..65535");
+  if (ec != std::errc{} || end != portText.data() + portText.size() || port == 0 || port > 65535) {
+    return bad();
   }
   return DeviceAddress{host, static_cast<std::uint16_t>(port)};
 }
 
-std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& address,
-                                                         std::chrono::milliseconds timeout,
-                                                         int receiveBufferBytes) {
-  const std::string where = address.host + ":" + std::to_string(address.port);
-  addrinfo hints{};
-  hints.ai_family = AF_INET;
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* found = nullptr;
-  if (const int err = ::getaddrinfo(address.host.c_str(), nullptr, &hints, &found); err != 0) {
-    return std::unexpected("cannot resolve '" + address.host + "': " + ::gai_strerror(err));
-  }
-  sockaddr_in target{};
-  std::memcpy(&target, found->ai_addr, sizeof target);
-  ::freeaddrinfo(found);
-  target.sin_port = htons(address.port);
+std::string toString(const DeviceAddress& address) {
+  const bool v6 = address.host.find(':') != std::string::npos;
+  return (v6 ? "[" + address.host + "]" : address.host) + ":" + std::to_string(address.port);
+}
 
-  UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+namespace {
+
+// One attempt on one resolved address; the socket when connected, else the reason.
+std::expected<UniqueFd, std::string> connectTo(const addrinfo& target, const std::string& where,
+                                               std::chrono::milliseconds timeout,
+                                               int receiveBufferBytes) {
+  UniqueFd fd(::socket(target.ai_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd.valid()) {
     return std::unexpected(detail::systemError("cannot create a socket"));
   }
-  if (receiveBufferBytes > 0) {  // before connect: it sets the window the device sees
+  detail::enableKeepAlive(fd.get());  // a device that lost power is noticed while streaming
+  if (receiveBufferBytes > 0) {       // before connect: it sets the window the device sees
     ::setsockopt(fd.get(), SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
   }
-  if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&target), sizeof target) != 0) {
+  if (::connect(fd.get(), target.ai_addr, target.ai_addrlen) != 0) {
     if (errno != EINPROGRESS) {
       return std::unexpected(detail::systemError("cannot connect to " + where));
     }
@@ -88,7 +117,40 @@ std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& ad
   }
   const int yes = 1;
   ::setsockopt(fd.get(), IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
-  return TcpClient(std::move(fd));
+  return fd;
+}
+
+}  // namespace
+
+std::expected<TcpClient, std::string> TcpClient::connect(const DeviceAddress& address,
+                                                         std::chrono::milliseconds timeout,
+                                                         int receiveBufferBytes) {
+  const std::string where = toString(address);
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string port = std::to_string(address.port);
+  if (const int err = ::getaddrinfo(address.host.c_str(), port.c_str(), &hints, &found); err != 0) {
+    return std::unexpected("cannot resolve '" + address.host + "': " + ::gai_strerror(err));
+  }
+  const std::unique_ptr<addrinfo, decltype(&::freeaddrinfo)> results(found, ::freeaddrinfo);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::string reason = "cannot connect to " + where + ": no address";
+  for (const addrinfo* target = found; target != nullptr; target = target->ai_next) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      break;
+    }
+    auto fd = connectTo(*target, where, left, receiveBufferBytes);
+    if (fd) {
+      return TcpClient(std::move(*fd));
+    }
+    reason = fd.error();
+  }
+  return std::unexpected(reason);
 }
 
 std::expected<void, std::string> TcpClient::sendAll(std::span<const std::byte> bytes,

@@ -27,18 +27,24 @@ struct DeviceOptions {
   std::size_t queueSlots = 4;  // range frames waiting for the host (all cameras)
   int decodeThreads = 0;       // cameras decoded in parallel (0: one thread per camera)
   std::int64_t acquireTimeoutNs = 2'000'000'000;
+  // A host that sends nothing while not streaming, or reads nothing while the device has data
+  // for it, for this long is disconnected so that another can use the device (0: never).
+  // Long enough for a person between two commands of a host program or a slow disk write on
+  // the host; short enough that a forgotten or vanished host frees the scanner in half a minute.
+  std::int64_t idleTimeoutNs = 30'000'000'000;
   algo::PipelineOptions pipeline;  // depthUnitM is taken from the board
 };
 
 // Counters, readable from any thread while the loops run.
 struct DeviceCounters {
-  std::atomic<std::uint64_t> framesCaptured = 0;  // camera frames acquired
-  std::atomic<std::uint64_t> framesDecoded = 0;   // range frames computed
-  std::atomic<std::uint64_t> framesQueued = 0;    // range frames handed to the send queue
-  std::atomic<std::uint64_t> framesSent = 0;      // range frames fully given to the link
-  std::atomic<std::uint64_t> captureErrors = 0;   // timeouts, lost cameras, failed frames
-  std::atomic<std::uint64_t> protocolErrors = 0;  // bad messages from the host
-  std::atomic<std::uint64_t> connections = 0;     // hosts served so far
+  std::atomic<std::uint64_t> framesCaptured = 0;   // camera frames acquired
+  std::atomic<std::uint64_t> framesDecoded = 0;    // range frames computed
+  std::atomic<std::uint64_t> framesQueued = 0;     // range frames handed to the send queue
+  std::atomic<std::uint64_t> framesSent = 0;       // range frames fully given to the link
+  std::atomic<std::uint64_t> captureErrors = 0;    // timeouts, lost cameras, failed frames
+  std::atomic<std::uint64_t> protocolErrors = 0;   // bad messages from the host
+  std::atomic<std::uint64_t> connections = 0;      // hosts served so far
+  std::atomic<std::uint64_t> idleDisconnects = 0;  // hosts dropped after the idle timeout
   std::atomic<std::uint64_t> decodeTimeUsTotal = 0;
   std::atomic<std::uint32_t> decodeTimeUsLast = 0;
 };
@@ -63,7 +69,11 @@ class Device {
 
   [[nodiscard]] const DeviceCounters& counters() const { return counters_; }
   [[nodiscard]] std::uint64_t framesDropped() const { return queue_.dropped(); }
+  // Since start-up, every host together (the daemon's status line).
   [[nodiscard]] protocol::Statistics statistics() const;
+  // What the connected host is sent: frames sent and dropped and protocol errors count for its
+  // connection only, the rest since start-up (docs/protocol.md, message 7).
+  [[nodiscard]] protocol::Statistics statisticsForHost() const;
   [[nodiscard]] bool streaming() const { return streaming_; }
   [[nodiscard]] std::size_t arenaBytes() const;
   [[nodiscard]] const hal::Hal& hal() const { return hal_; }
@@ -81,7 +91,8 @@ class Device {
   void onMessage(const protocol::Message& message);
   void sendControl(std::span<const std::byte> message);
   void dropConnection();
-  void pumpSend();
+  void pumpSend(std::int64_t nowNs);
+  [[nodiscard]] bool idle(std::int64_t nowNs) const;
 
   hal::Hal hal_;
   DeviceOptions options_;
@@ -108,6 +119,12 @@ class Device {
   std::size_t sent_ = 0;
   bool helloSeen_ = false;
   bool hadClient_ = false;
+  std::int64_t lastReceivedNs_ = 0;  // the host last sent bytes
+  std::int64_t lastSentNs_ = 0;      // the socket last took bytes, or nothing was waiting
+  // The counters when this host connected: statisticsForHost() reports what happened since.
+  std::uint64_t sentAtConnect_ = 0;
+  std::uint64_t droppedAtConnect_ = 0;
+  std::uint64_t protocolErrorsAtConnect_ = 0;
 };
 
 }  // namespace smx::device

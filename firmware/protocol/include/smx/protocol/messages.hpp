@@ -60,10 +60,10 @@ struct Statistics {
   std::uint64_t uptimeMs = 0;
   std::uint64_t framesCaptured = 0;  // camera frames acquired
   std::uint64_t framesDecoded = 0;   // range frames computed (one per camera per capture)
-  std::uint64_t framesSent = 0;      // range frames fully handed to the link
-  std::uint64_t framesDropped = 0;   // dropped from the send queue because the host was slow
+  std::uint64_t framesSent = 0;      // range frames fully handed to the link (this connection)
+  std::uint64_t framesDropped = 0;   // dropped because the host was slow (this connection)
   std::uint64_t captureErrors = 0;   // timeouts, lost cameras
-  std::uint64_t protocolErrors = 0;  // malformed messages received
+  std::uint64_t protocolErrors = 0;  // malformed messages received (this connection)
   std::uint32_t decodeTimeUsLast = 0;
   std::uint32_t decodeTimeUsMean = 0;
 };

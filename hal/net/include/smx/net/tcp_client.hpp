@@ -14,16 +14,20 @@
 namespace smx::net {
 
 struct DeviceAddress {
-  std::string host;
+  std::string host;  // a name, an IPv4 address or an IPv6 address without brackets
   std::uint16_t port = 0;
 };
 
-// "HOST" or "HOST:PORT" (defaultPort when absent); "[v6]:port" is not supported yet.
+// "HOST", "HOST:PORT", "[V6]", "[V6]:PORT" or a bare IPv6 address ("::1", "fe80::1%eth0";
+// more than one colon, so a port needs the brackets); defaultPort when none is given.
 [[nodiscard]] std::expected<DeviceAddress, std::string> parseDeviceAddress(
     const std::string& text, std::uint16_t defaultPort);
+// "host:port", or "[v6]:port" for an IPv6 address: what a user can pass back to --device.
+[[nodiscard]] std::string toString(const DeviceAddress& address);
 
 class TcpClient {
  public:
+  // Tries each address the host resolves to (IPv6 and IPv4) in the resolver's order.
   // receiveBufferBytes > 0 caps the kernel's receive buffer: a host that falls behind then
   // holds back the device, which drops its oldest frames, instead of collecting stale ones.
   [[nodiscard]] static std::expected<TcpClient, std::string> connect(

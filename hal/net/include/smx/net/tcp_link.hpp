@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <expected>
 #include <memory>
 #include <string>
@@ -8,9 +10,11 @@
 #include "smx/hal/link.hpp"
 #include "smx/net/unique_fd.hpp"
 
-// hal::Link over TCP (IPv4): listens on the board's address and port and serves one host; a
-// second host that connects while one is served is accepted and closed at once, so it sees the
-// device as busy instead of hanging in the backlog. Used by every board, the simulated one too.
+// hal::Link over TCP, IPv4 or IPv6 (docs/protocol.md "Connections"): listens on the board's
+// address and port and serves one host, with TCP keepalive. A second host that connects while
+// one is served gets the protocol's `busy` error naming the host that holds the device and for
+// how long, then the connection is closed: it learns why at once instead of hanging in the
+// backlog. Used by every board, the simulated one too. No heap after create().
 namespace smx::net {
 
 class TcpLink final : public hal::Link {
@@ -32,15 +36,27 @@ class TcpLink final : public hal::Link {
   [[nodiscard]] std::uint64_t refusedClients() const { return refused_; }
 
  private:
+  // A turned-away host's connection: its `busy` error is sent and our side shut down; it is
+  // closed when the host closes or after kRefusedLingerNs, so that a request the host sent
+  // meanwhile does not make the kernel reset the connection before the host read the error.
+  struct Refused {
+    UniqueFd fd;
+    std::int64_t closeAtNs = 0;
+  };
+
   TcpLink(UniqueFd listener, std::uint16_t port, int sendBufferBytes)
       : listener_(std::move(listener)), port_(port), sendBufferBytes_(sendBufferBytes) {}
   void refusePending();
+  void closeRefused(std::int64_t nowNs);
 
   UniqueFd listener_;
   UniqueFd client_;
   std::uint16_t port_;
   int sendBufferBytes_;
   std::uint64_t refused_ = 0;
+  std::array<char, 64> clientAddress_{};  // "a.b.c.d:port" or "[v6]:port"
+  std::int64_t clientSinceNs_ = 0;        // CLOCK_MONOTONIC
+  std::array<Refused, 4> refusedOpen_;
 };
 
 }  // namespace smx::net
