@@ -50,14 +50,14 @@ TEST_F(CliHostileDevice, CameraIdThatIsAPathIsRefusedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(work / "out"));
 }
 
-// Given a device whose board name and firmware version carry terminal escape sequences (a title
-// change, a screen clear), when `info` and `stream` print them, then no escape byte reaches the
-// terminal: each is shown as \x1b.
+// Given a device whose firmware version carries terminal escape sequences (a title change, a
+// screen clear, a C1 CSI), when `info` and `stream` print it, then no escape byte reaches the
+// terminal: each is shown as \xNN.
 TEST_F(CliHostileDevice, EscapeSequencesFromTheDeviceNeverReachTheTerminal) {
   for (const std::string command : {"info", "stream"}) {
-    test::FakeDevice device({.board = "evil\x1b]0;owned\x07\xc2\x9b"
-                                      "2J",
-                             .firmwareVersion = "\x1b[2J1.0",
+    test::FakeDevice device({.board = "fake",
+                             .firmwareVersion = "evil\x1b]0;owned\x07\xc2\x9b"
+                                                "2J",
                              .rigJson = exampleRigWith("", ""),
                              .width = 640,
                              .height = 480,
@@ -76,6 +76,21 @@ TEST_F(CliHostileDevice, EscapeSequencesFromTheDeviceNeverReachTheTerminal) {
     EXPECT_NE(printed.find("evil\\x1b]0;owned\\x07\\xc2\\x9b2J"), std::string::npos)
         << command << ": " << printed;
   }
+}
+
+// Given a device whose board name is not an id (here an escape sequence), when `info` connects,
+// then it refuses the device naming the board name, and the message shows the name escaped.
+TEST_F(CliHostileDevice, BoardNameThatIsNotAnIdIsRefused) {
+  test::FakeDevice device({.board = "evil\x1b[2J",
+                           .firmwareVersion = "1.0",
+                           .rigJson = exampleRigWith("", ""),
+                           .width = 640,
+                           .height = 480,
+                           .framesPerStart = 0});
+  const auto result = test::runCli({"info", "--device", device.address()});
+  EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
+  EXPECT_NE(result.err.find("the device's board name"), std::string::npos) << result.err;
+  EXPECT_EQ((result.out + result.err).find('\x1b'), std::string::npos) << result.err;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "smx/config/identifier.hpp"
 #include "smx/hal/steady_clock.hpp"
 #include "smx/protocol/rig_json.hpp"
 
@@ -83,6 +84,10 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
     return Fail(where + ": bad answer to hello: " + caps.error().message);
   }
   DeviceInfo& info = client.info_;
+  // The board name is an id like any other (docs/rig-format.md, "Ids"): devices are not trusted.
+  if (auto problem = config::identifierProblem(caps->board)) {
+    return Fail(where + ": the device's board name " + *problem);
+  }
   info.board = caps->board;
   info.firmwareVersion = caps->firmwareVersion;
   info.halBackend = caps->halBackend;
