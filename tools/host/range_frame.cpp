@@ -3,16 +3,26 @@
 namespace smx::host {
 
 std::expected<ReceivedFrame, std::string> receiveRangeFrame(std::span<const std::byte> payload,
-                                                            const AnnouncedFrames& /*announced*/,
+                                                            const AnnouncedFrames& announced,
                                                             std::int64_t receivedNs) {
   using Fail = std::unexpected<std::string>;
   const auto frame = protocol::decodeRangeFrame(payload);
   if (!frame) {
     return Fail(std::string("bad range frame: ") + frame.error().message);
   }
+  const protocol::RangeFrameHeader& header = frame->header;
+  if (header.camera >= announced.cameras) {
+    return Fail("bad range frame: camera " + std::to_string(header.camera) +
+                ", but the device announced " + std::to_string(announced.cameras) + " camera(s)");
+  }
+  if (header.width != announced.width || header.height != announced.height) {
+    return Fail("bad range frame: " + std::to_string(header.width) + "x" +
+                std::to_string(header.height) + ", but the device announced " +
+                std::to_string(announced.width) + "x" + std::to_string(announced.height));
+  }
   ReceivedFrame received;
-  received.header = frame->header;
-  received.depth.resize(std::size_t{frame->header.width} * frame->header.height);
+  received.header = header;
+  received.depth.resize(std::size_t{header.width} * header.height);
   if (const auto ok = protocol::decodeRangeDepth(*frame, received.depth); !ok) {
     return Fail(std::string("bad range frame: ") + ok.error().message);
   }

@@ -9,7 +9,9 @@
 
 #include "smx/protocol/messages.hpp"
 
-// A range-frame message from the device as the host keeps it.
+// A range-frame message from the device as the host keeps it. The frame's header comes from the
+// network, so its camera and size are checked against what the device announced before the
+// depth is allocated.
 namespace smx::host {
 
 struct ReceivedFrame {
@@ -27,8 +29,9 @@ struct AnnouncedFrames {
   int height = 0;
 };
 
-// The range frame of a message payload (without the message header), received at receivedNs;
-// a payload that does not decode is an error.
+// The range frame of a message payload (without the message header), received at receivedNs.
+// A camera index outside the announced cameras or a size other than the announced one is an
+// error naming both, found before anything is allocated; so is a payload that does not decode.
 [[nodiscard]] std::expected<ReceivedFrame, std::string> receiveRangeFrame(
     std::span<const std::byte> payload, const AnnouncedFrames& announced, std::int64_t receivedNs);
 
