@@ -205,8 +205,9 @@ TEST(SimIo, PngClaimingTheLargestSizesIsRefusedNamingBothSizes) {
 }
 
 // Given a caller that knows the size (a 640x480 camera), when a PNG claims another, then the
-// error names the claim and the camera's size; the in-memory reader, which the file reader
-// uses, gives the same answers; sizes at the limits pass and one pixel more does not.
+// error names the claim and the camera's size, and an expected size beyond the maxima is refused;
+// the in-memory reader, which the file reader uses, gives the same answers; sizes at the limits
+// pass and one pixel more does not.
 TEST(SimIo, PngSizeLimitsAreExactForCamerasAndInclusiveMaxima) {
   const auto huge = test::pngClaiming(20000, 20000);
   const auto camera = readPngRgb8(huge, "upload.png", PngSizeLimit::exactly(640, 480, "camera c0"));
@@ -214,6 +215,11 @@ TEST(SimIo, PngSizeLimitsAreExactForCamerasAndInclusiveMaxima) {
   EXPECT_NE(camera.error().find("upload.png: image is 20000x20000, camera c0 is 640x480"),
             std::string::npos)
       << camera.error();
+  // A camera size from a rig is input too: the maxima hold for it.
+  const auto big =
+      readPngRgb8(huge, "upload.png", PngSizeLimit::exactly(20000, 20000, "camera c1"));
+  ASSERT_FALSE(big.has_value());
+  EXPECT_NE(big.error().find("16384x16384"), std::string::npos) << big.error();
 
   std::vector<algo::Rgb8> px = {{1, 2, 3}, {4, 5, 6}};
   const auto path = tempFile("two.png");

@@ -47,18 +47,17 @@ std::string sizeText(std::uint64_t width, std::uint64_t height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-// The header's claim against the limit, before anything is allocated for the pixels.
+// The header's claim against the limit, before anything is allocated for the pixels. The maxima
+// hold for an expected size too: it comes from a file as well (a rig allows 65535 a side).
 std::expected<void, std::string> checkSize(std::string_view name, std::uint64_t width,
                                            std::uint64_t height, const PngSizeLimit& limit) {
   const std::string prefix = std::string(name) + ": image is " + sizeText(width, height);
-  if (limit.width > 0 && limit.height > 0) {
-    if (width != static_cast<std::uint64_t>(limit.width) ||
-        height != static_cast<std::uint64_t>(limit.height)) {
-      return std::unexpected(prefix + ", " + std::string(limit.owner) + " is " +
-                             sizeText(static_cast<std::uint64_t>(limit.width),
-                                      static_cast<std::uint64_t>(limit.height)));
-    }
-    return {};
+  if (limit.width > 0 && limit.height > 0 &&
+      (width != static_cast<std::uint64_t>(limit.width) ||
+       height != static_cast<std::uint64_t>(limit.height))) {
+    return std::unexpected(prefix + ", " + std::string(limit.owner) + " is " +
+                           sizeText(static_cast<std::uint64_t>(limit.width),
+                                    static_cast<std::uint64_t>(limit.height)));
   }
   const auto maxSide = static_cast<std::uint64_t>(limit.maxSide);
   if (width > maxSide || height > maxSide || width * height > limit.maxPixels) {

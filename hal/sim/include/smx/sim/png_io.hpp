@@ -26,7 +26,7 @@ inline constexpr std::uint64_t kPngMaxPixels = std::uint64_t{1} << 26U;
 
 // The sizes a reader accepts, checked against the file's header before any pixel is allocated.
 struct PngSizeLimit {
-  int width = 0;   // exactly this size when both are > 0 (a camera's image), else any size
+  int width = 0;   // exactly this size when both are > 0 (a camera's image); in any case
   int height = 0;  // within the maxima
   std::string_view owner = "the expected size";  // whose size width x height is, for errors
   int maxSide = kPngMaxSide;
