@@ -58,6 +58,19 @@ TEST(RangeFrame, SizeOtherThanAnnouncedIsRefusedBeforeAllocating) {
   EXPECT_NE(small.error().find("320x240"), std::string::npos) << small.error();
 }
 
+// Given a device that announced 65535x65535 itself (its capabilities are network input too),
+// when a frame of that size arrives, then it is refused as more than a range frame carries,
+// before anything near its size is allocated.
+TEST(RangeFrame, AnnouncedSizeBeyondWhatAFrameCarriesIsRefused) {
+  const auto payload = bareRangeFrame(0, 65535, 65535);
+  const test::AllocationCounter counter;
+  const auto frame = receiveRangeFrame(payload, {.cameras = 1, .width = 65535, .height = 65535}, 0);
+  EXPECT_LT(counter.bytes(), 4096U);
+  ASSERT_FALSE(frame.has_value());
+  EXPECT_NE(frame.error().find("65535x65535"), std::string::npos) << frame.error();
+  EXPECT_NE(frame.error().find("2097152 pixels"), std::string::npos) << frame.error();
+}
+
 // Given a device that announced 2 cameras, when a frame names camera 2, then it is refused
 // naming the index and the count.
 TEST(RangeFrame, CameraIndexBeyondTheAnnouncedCountIsRefused) {

@@ -30,8 +30,9 @@ struct AnnouncedFrames {
 };
 
 // The range frame of a message payload (without the message header), received at receivedNs.
-// A camera index outside the announced cameras or a size other than the announced one is an
-// error naming both, found before anything is allocated; so is a payload that does not decode.
+// A camera index outside the announced cameras, a size other than the announced one, or more
+// pixels than an uncompressed frame can carry (protocol::kMaxPayloadBytes / 2) is an error
+// naming both, found before anything is allocated; so is a payload that does not decode.
 [[nodiscard]] std::expected<ReceivedFrame, std::string> receiveRangeFrame(
     std::span<const std::byte> payload, const AnnouncedFrames& announced, std::int64_t receivedNs);
 
