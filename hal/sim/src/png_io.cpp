@@ -61,8 +61,8 @@ std::expected<void, std::string> checkSize(std::string_view name, std::uint64_t 
   }
   const auto maxSide = static_cast<std::uint64_t>(limit.maxSide);
   if (width > maxSide || height > maxSide || width * height > limit.maxPixels) {
-    return std::unexpected(prefix + ", larger than the " + sizeText(maxSide, maxSide) + " and " +
-                           std::to_string(limit.maxPixels) + " pixels read at most");
+    return std::unexpected(prefix + "; images are read up to " + std::to_string(maxSide) +
+                           " pixels a side and " + std::to_string(limit.maxPixels) + " in all");
   }
   return {};
 }
