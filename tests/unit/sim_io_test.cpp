@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "png_claim.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
@@ -204,6 +205,23 @@ TEST(SimIo, PngClaimingTheLargestSizesIsRefusedNamingBothSizes) {
         << rgb.error();
     fs::remove(path);
   }
+}
+
+// Given the 45 bytes png_fuzz found (a 1x1 IHDR, then an "sPLT" chunk claiming 1951419476
+// bytes with none behind it), when read, then the chunk is refused by name before anything
+// near its claim is allocated (libpng allocated the claim, then found the data missing).
+TEST(SimIo, PngChunkClaimingMoreThanTheFileHasIsRefusedUnallocated) {
+  const std::vector<std::uint8_t> found = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+      0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x10, 0x06, 0x00, 0x00, 0x00, 0x4f,
+      0x85, 0x18, 0xca, 0x74, 0x50, 0x4c, 0x54, 0x73, 0x50, 0x4c, 0x54, 0x49, 0x44, 0x41, 0x54};
+  const test::AllocationCounter counter;
+  const auto rgb = readPngRgb8(std::as_bytes(std::span(found)), "found.png");
+  EXPECT_LT(counter.bytes(), 1U << 20U);
+  ASSERT_FALSE(rgb.has_value());
+  EXPECT_NE(rgb.error().find("found.png: chunk \"sPLT\" claims 1951419476 bytes"),
+            std::string::npos)
+      << rgb.error();
 }
 
 // Given a caller that knows the size (a 640x480 camera), when a PNG claims another, then the

@@ -75,6 +75,34 @@ std::uint64_t bigEndian32(std::span<const std::byte> bytes) {
   return value;
 }
 
+// Each chunk's length against the bytes the file has left. libpng allocates what an ancillary
+// chunk (sPLT) claims before it reads the data, so a chunk of 45 bytes could cost 2 GB. Bytes that
+// are not a PNG, or cut inside a chunk's frame, are left to libpng to name.
+std::expected<void, std::string> checkChunkLengths(std::span<const std::byte> bytes,
+                                                   std::string_view name) {
+  constexpr std::size_t kSignature = 8;
+  constexpr std::size_t kChunkFrame = 12;  // length, type, CRC
+  if (bytes.size() < kSignature ||
+      png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, kSignature) != 0) {
+    return {};
+  }
+  for (std::size_t at = kSignature; bytes.size() - at >= kChunkFrame;) {
+    const std::size_t left = bytes.size() - at - kChunkFrame;
+    const std::uint64_t length = bigEndian32(bytes.subspan(at));
+    const std::string type(reinterpret_cast<const char*>(bytes.data() + at + 4), 4);
+    if (length > left) {
+      return std::unexpected(std::string(name) + ": chunk \"" + type + "\" claims " +
+                             std::to_string(length) + " bytes, but the file has " +
+                             std::to_string(left) + " left");
+    }
+    if (type == "IEND") {
+      break;
+    }
+    at += kChunkFrame + static_cast<std::size_t>(length);
+  }
+  return {};
+}
+
 // The header of a PNG in memory, checked against the limit; the caller frees `png`. The size is
 // taken from the IHDR chunk (always the first, at a fixed place) before libpng sees the file,
 // so that every claim gets the same message whatever limits the installed libpng has.
@@ -89,6 +117,9 @@ std::expected<void, std::string> beginRead(std::span<const std::byte> bytes, std
         !size) {
       return size;
     }
+  }
+  if (auto chunks = checkChunkLengths(bytes, name); !chunks) {
+    return chunks;
   }
   png.version = PNG_IMAGE_VERSION;
   if (png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()) == 0) {

@@ -14,13 +14,12 @@
 // PNG files for the host tool and the simulated camera (libpng's simplified API). Errors are
 // messages naming the file.
 //
-// A PNG's header can claim any size up to 2^31 - 1 pixels a side in a few hundred bytes, so every
+// A PNG's header can claim any size up to 2^31 - 1 pixels a side in a few dozen bytes, so every
 // reader checks the claim against a PngSizeLimit before it allocates the pixels.
 namespace smx::sim {
 
-// The largest PNG a reader accepts when its caller does not know the size: 16384 pixels a side
-// and 64 Mpixel in all, more than any machine-vision sensor or scene texture in use, and at most
-// 192 MiB as 8-bit RGB.
+// The largest PNG any reader accepts: 16384 pixels a side and 64 Mpixel in all, more than any
+// machine-vision sensor or scene texture in use, and at most 192 MiB as 8-bit RGB.
 inline constexpr int kPngMaxSide = 16384;
 inline constexpr std::uint64_t kPngMaxPixels = std::uint64_t{1} << 26U;
 
