@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "cli_harness.hpp"
+#include "png_claim.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
@@ -137,6 +138,22 @@ TEST_F(CliDecode, BadImagesAndCamerasExitTwoNamingThem) {
 
   const auto usage = test::runCli({"decode", "--rig", kRig2Cam, "--out", out});
   EXPECT_EQ(usage.code, kExitUsage);
+}
+
+// Given a 65-byte PNG claiming 20000x20000 pixels for a 640x480 camera, when decoded, then the
+// command exits 2 naming the file and both sizes, having refused the header before allocating
+// the 1.2 GB it claims.
+TEST_F(CliDecode, ImageClaimingAHugeSizeExitsTwoNamingTheFileAndBothSizes) {
+  const auto bomb = test::pngClaiming(20000, 20000);
+  const auto file = dir_ / "bomb.png";
+  std::ofstream(file, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bomb.data()), static_cast<std::streamsize>(bomb.size()));
+  const auto result = test::runCli({"decode", "--rig", kRig2Cam, "--image", "cam0=" + file.string(),
+                                    "--out", (dir_ / "out").string()});
+  EXPECT_EQ(result.code, kExitBadInput);
+  EXPECT_NE(result.err.find("bomb.png: image is 20000x20000, camera cam0 is 640x480"),
+            std::string::npos)
+      << result.err;
 }
 
 }  // namespace

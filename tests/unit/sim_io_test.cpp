@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "alloc_counter.hpp"
+#include "png_claim.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
@@ -21,6 +23,12 @@ namespace fs = std::filesystem;
 
 fs::path tempFile(const std::string& name) {
   return fs::temp_directory_path() / ("smx_sim_io_" + name);
+}
+
+void writeBytes(const fs::path& path, const std::vector<std::byte>& bytes) {
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
 }
 
 // Given a 3x2 grey float image, when written as PFM, then the bytes follow the format: header
@@ -170,6 +178,95 @@ TEST(SimIo, Gray16ReaderNamesOtherKindsOfPng) {
   ASSERT_FALSE(r.has_value());
   EXPECT_NE(r.error().find("grey8.png"), std::string::npos) << r.error();
   EXPECT_NE(r.error().find("8-bit"), std::string::npos) << r.error();
+  fs::remove(path);
+}
+
+// Given a 65-byte PNG whose header claims 20000x20000 pixels (1.2 GB as RGB), when read, then
+// it is refused against the global maximum before the pixels are allocated, naming the file and
+// both sizes.
+TEST(SimIo, PngClaiming20000SquaredIsRefusedNamingBothSizes) {
+  const auto path = tempFile("claims_20000.png");
+  writeBytes(path, test::pngClaiming(20000, 20000));
+  const auto rgb = readPngRgb8(path);
+  ASSERT_FALSE(rgb.has_value());
+  EXPECT_NE(rgb.error().find("claims_20000.png: image is 20000x20000"), std::string::npos)
+      << rgb.error();
+  EXPECT_NE(rgb.error().find("up to 16384 pixels a side and 67108864 in all"), std::string::npos)
+      << rgb.error();
+  const auto grey = readPngGray16(path);
+  ASSERT_FALSE(grey.has_value());
+  EXPECT_NE(grey.error().find("claims_20000.png: image is 20000x20000"), std::string::npos)
+      << grey.error();
+  fs::remove(path);
+}
+
+// Given headers claiming 2^31 - 1 pixels a side (the most PNG allows) and 10^6 (the most
+// libpng's default limits let through: 3 TB as RGB), when read, then both are refused by the
+// same size check naming both sizes, never by std::bad_alloc.
+TEST(SimIo, PngClaimingTheLargestSizesIsRefusedNamingBothSizes) {
+  for (const std::uint32_t side : {2147483647U, 1000000U}) {
+    const auto path = tempFile("claims_" + std::to_string(side) + ".png");
+    writeBytes(path, test::pngClaiming(side, side));
+    const auto rgb = readPngRgb8(path);
+    ASSERT_FALSE(rgb.has_value());
+    EXPECT_NE(rgb.error().find(path.filename().string() + ": image is " + std::to_string(side) +
+                               "x" + std::to_string(side)),
+              std::string::npos)
+        << rgb.error();
+    EXPECT_NE(rgb.error().find("up to 16384 pixels a side and 67108864 in all"), std::string::npos)
+        << rgb.error();
+    fs::remove(path);
+  }
+}
+
+// Given the 45 bytes png_fuzz found (a 1x1 IHDR, then an "sPLT" chunk claiming 1951419476
+// bytes with none behind it), when read, then the chunk is refused by name before anything
+// near its claim is allocated (libpng allocated the claim, then found the data missing).
+TEST(SimIo, PngChunkClaimingMoreThanTheFileHasIsRefusedUnallocated) {
+  const std::vector<std::uint8_t> found = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+      0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x10, 0x06, 0x00, 0x00, 0x00, 0x4f,
+      0x85, 0x18, 0xca, 0x74, 0x50, 0x4c, 0x54, 0x73, 0x50, 0x4c, 0x54, 0x49, 0x44, 0x41, 0x54};
+  const test::AllocationCounter counter;
+  const auto rgb = readPngRgb8(std::as_bytes(std::span(found)), "found.png");
+  EXPECT_LT(counter.bytes(), 1U << 20U);
+  ASSERT_FALSE(rgb.has_value());
+  EXPECT_NE(rgb.error().find("found.png: chunk \"sPLT\" claims 1951419476 bytes"),
+            std::string::npos)
+      << rgb.error();
+}
+
+// Given a caller that knows the size (a 640x480 camera), when a PNG claims another, then the
+// error names the claim and the camera's size, and an expected size beyond the maxima is refused;
+// the in-memory reader, which the file reader uses, gives the same answers; sizes at the limits
+// pass and one pixel more does not.
+TEST(SimIo, PngSizeLimitsAreExactForCamerasAndInclusiveMaxima) {
+  const auto huge = test::pngClaiming(20000, 20000);
+  const auto camera = readPngRgb8(huge, "upload.png", PngSizeLimit::exactly(640, 480, "camera c0"));
+  ASSERT_FALSE(camera.has_value());
+  EXPECT_NE(camera.error().find("upload.png: image is 20000x20000, camera c0 is 640x480"),
+            std::string::npos)
+      << camera.error();
+  // A camera size from a rig is input too: the maxima hold for it.
+  const auto big =
+      readPngRgb8(huge, "upload.png", PngSizeLimit::exactly(20000, 20000, "camera c1"));
+  ASSERT_FALSE(big.has_value());
+  EXPECT_NE(big.error().find("up to 16384 pixels a side and 67108864 in all"), std::string::npos)
+      << big.error();
+
+  std::vector<algo::Rgb8> px = {{1, 2, 3}, {4, 5, 6}};
+  const auto path = tempFile("two.png");
+  ASSERT_TRUE(writePngRgb8(path, *algo::ConstRgbView::packed(px, 2, 1)));
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<char> file((std::istreambuf_iterator<char>(in)), {});
+  const auto bytes = std::as_bytes(std::span(file));
+  const auto back = readPngRgb8(bytes, "two.png", PngSizeLimit{.maxSide = 2, .maxPixels = 2});
+  ASSERT_TRUE(back.has_value()) << back.error();
+  EXPECT_EQ(back->pixels[1].g, 5);
+  EXPECT_FALSE(readPngRgb8(bytes, "two.png", {.maxSide = 1, .maxPixels = 2}).has_value());
+  EXPECT_FALSE(readPngRgb8(bytes, "two.png", {.maxSide = 2, .maxPixels = 1}).has_value());
+  EXPECT_TRUE(readPngRgb8(path, PngSizeLimit::exactly(2, 1, "camera c")).has_value());
+  EXPECT_FALSE(readPngRgb8(path, PngSizeLimit::exactly(1, 2, "camera c")).has_value());
   fs::remove(path);
 }
 

@@ -83,16 +83,9 @@ std::expected<RigAndImages, std::string> loadRigAndImages(const std::filesystem:
 
 std::expected<sim::RgbImage, std::string> readCameraImage(const std::filesystem::path& file,
                                                           const algo::Camera& camera) {
-  auto image = sim::readPngRgb8(file);
-  if (!image) {
-    return std::unexpected(image.error());
-  }
-  if (image->width != camera.width || image->height != camera.height) {
-    return std::unexpected(file.string() + ": image is " + std::to_string(image->width) + "x" +
-                           std::to_string(image->height) + ", camera " + camera.id + " is " +
-                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  }
-  return image;
+  // The camera's size is checked against the file's header, before the pixels are allocated.
+  const std::string owner = "camera " + camera.id;
+  return sim::readPngRgb8(file, sim::PngSizeLimit::exactly(camera.width, camera.height, owner));
 }
 
 }  // namespace smx::host

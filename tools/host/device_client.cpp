@@ -169,21 +169,14 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
   const auto& [type, payload] = *got;
   switch (type) {
     case MessageType::kRangeFrame: {
-      const auto frame = protocol::decodeRangeFrame(payload);
-      if (!frame) {
-        return Fail(std::string("bad range frame: ") + frame.error().message);
+      auto received = receiveRangeFrame(payload, {info_.cameras, info_.width, info_.height},
+                                        hal::SteadyClock().nowNs());
+      if (!received) {
+        return Fail(received.error());
       }
-      ReceivedFrame received;
-      received.header = frame->header;
-      received.depth.resize(std::size_t{frame->header.width} * frame->header.height);
-      if (const auto ok = protocol::decodeRangeDepth(*frame, received.depth); !ok) {
-        return Fail(std::string("bad range frame: ") + ok.error().message);
-      }
-      received.wireBytes = protocol::kHeaderBytes + payload.size();
-      received.receivedNs = hal::SteadyClock().nowNs();
       DeviceEvent event;
       event.kind = DeviceEvent::Kind::kFrame;
-      event.frame = std::move(received);
+      event.frame = std::move(*received);
       return event;
     }
     case MessageType::kStatistics: {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "range_frame.hpp"
 #include "smx/algo/rig.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
@@ -31,13 +32,6 @@ struct DeviceInfo {
   std::uint8_t compressionsMask = 0;
   std::string rigJson;
   algo::Rig rig;
-};
-
-struct ReceivedFrame {
-  protocol::RangeFrameHeader header;
-  std::vector<std::uint16_t> depth;  // width × height, row by row
-  std::size_t wireBytes = 0;         // the whole message
-  std::int64_t receivedNs = 0;       // host CLOCK_MONOTONIC
 };
 
 // What next() found: a range frame, the device's statistics, or nothing before the timeout.

@@ -66,14 +66,12 @@ std::expected<std::vector<sim::RgbImage>, std::string> loadReplay(const fs::path
     if (!fs::exists(file)) {
       break;
     }
-    auto image = sim::readPngRgb8(file);
+    // The camera's size is checked against the file's header, before the pixels are allocated.
+    const std::string owner = "camera " + camera.id;
+    auto image =
+        sim::readPngRgb8(file, sim::PngSizeLimit::exactly(camera.width, camera.height, owner));
     if (!image) {
       return Fail(image.error());
-    }
-    if (image->width != camera.width || image->height != camera.height) {
-      return Fail(file.string() + ": " + std::to_string(image->width) + "x" +
-                  std::to_string(image->height) + ", but camera " + camera.id + " is " +
-                  std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
     frames.push_back(std::move(*image));
   }

@@ -1,0 +1,179 @@
+#!/usr/bin/env python3
+"""Writes the seed corpora of the fuzz targets (tests/fuzz/corpus/<target>/) and the texture the
+scene seeds name (tests/fuzz/files/texture.png): small valid inputs taken from the shipped boards,
+rigs and scenes or made here, and near-valid ones (a field cut short, a size claimed but not
+there). Deterministic; run it again after a format changes and commit what it writes.
+
+    tests/fuzz/make_seeds.py
+"""
+import json
+import pathlib
+import shutil
+import struct
+import zlib
+
+FUZZ = pathlib.Path(__file__).resolve().parent
+SRC = FUZZ.parent.parent
+CORPUS = FUZZ / "corpus"
+FILES = FUZZ / "files"
+# Paths as the board and scene targets see them: relative to tests/fuzz/files.
+RIG_FROM_FILES = "../../../boards/sim/"
+MESHES_FROM_FILES = "../../unit/testdata/meshes/"
+
+
+def write(target, name, data):
+    path = CORPUS / target / name
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
+
+
+def png(width, height, colour_type, bit_depth, rows, extra=()):
+    """A PNG with filter 0 on every row; `rows` is the raw bytes of each row."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+    ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, colour_type, 0, 0, 0)
+    raw = b"".join(b"\0" + row for row in rows)
+    out = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr)
+    for kind, data in extra:
+        out += chunk(kind, data)
+    return out + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b"")
+
+
+def png_seeds():
+    rgb = [bytes(sum(((x * 60, y * 80, 255 - x * 60) for x in range(4)), ())) for y in range(3)]
+    write("png", "rgb8_4x3.png", png(4, 3, 2, 8, rgb))
+    grey16 = [struct.pack(">3H", 0, 9000 + y, 65535) for y in range(2)]
+    write("png", "grey16_3x2.png", png(3, 2, 0, 16, grey16))
+    write("png", "grey8_2x2.png", png(2, 2, 0, 8, [b"\x00\xff", b"\x80\x40"]))
+    palette = [(b"PLTE", bytes((255, 0, 0, 0, 255, 0, 0, 0, 255))), (b"tRNS", b"\x80")]
+    write("png", "palette4_4x2.png", png(4, 2, 3, 8, [b"\x00\x01\x02\x00", b"\x02\x01\x00\x01"],
+                                         palette))
+    write("png", "rgba16_1x1.png", png(1, 1, 6, 16, [struct.pack(">4H", 1, 2, 3, 65535)]))
+    write("png", "grey_alpha_2x1_gamma.png",
+          png(2, 1, 4, 8, [b"\x10\x20\x30\x40"], [(b"gAMA", struct.pack(">I", 45455))]))
+    # Near-valid: a size claimed with no data behind it, data cut short, a wrong CRC.
+    write("png", "claims_20000x20000.png", png(20000, 20000, 2, 8, []))
+    whole = png(4, 3, 2, 8, rgb)
+    write("png", "truncated.png", whole[:-20])
+    write("png", "bad_crc.png", whole[:29] + b"\0\0\0\0" + whole[33:])
+
+
+def json_seeds():
+    for rig in sorted((SRC / "boards").glob("*/rig*.json")):
+        write("rig", f"{rig.parent.name}_{rig.name}", rig.read_text())
+    rig = json.loads((SRC / "boards/sim/rig_2proj_1cam.json").read_text())
+    near = json.loads(json.dumps(rig))
+    near["cameras"][0]["K"] = near["cameras"][0]["K"][:8]
+    write("rig", "near_short_K.json", json.dumps(near))
+    near = json.loads(json.dumps(rig))
+    near["projectors"][1]["id"] = near["projectors"][0]["id"]
+    write("rig", "near_duplicate_id.json", json.dumps(near))
+
+    for board in sorted((SRC / "boards").glob("*/board.json")):
+        value = json.loads(board.read_text())
+        value["rig"] = RIG_FROM_FILES + pathlib.Path(value["rig"]).name
+        write("board", f"{board.parent.name}.json", json.dumps(value, indent=1))
+    value = json.loads((SRC / "boards/sim/board.json").read_text())
+    value["rig"] = RIG_FROM_FILES + "rig_2proj_2cam.json"
+    value["sim"] = {"replay": ".", "seed": 3}
+    write("board", "near_replay.json", json.dumps(value))
+    value["cameras"] = value["cameras"][:1]
+    write("board", "near_one_camera_short.json", json.dumps(value))
+
+    for scene in sorted((SRC / "hal/sim/scenes").glob("*.json")):
+        value = json.loads(scene.read_text())
+        for obj in value["objects"]:
+            shape = obj.get("shape", {})
+            if shape.get("type") == "mesh":
+                shape["path"] = MESHES_FROM_FILES + "square.ply"
+        write("scene", scene.name, json.dumps(value, indent=1))
+    write("scene", "mesh_obj_texture.json", json.dumps({
+        "format": "stripemux-scene/1",
+        "objects": [
+            {"name": "obj", "shape": {"type": "mesh", "path": MESHES_FROM_FILES + "square.obj"},
+             "pose": {"t": [0, 0, 1], "rotation_deg": [0, 90, 0]},
+             "albedo": {"texture": {"path": "texture.png", "width_m": 0.1, "height_m": 0.1}}},
+            {"shape": {"type": "box", "size_m": [0.1, 0.1, 0.1]},
+             "motion": {"velocity_m_per_frame": [0.002, 0, 0]}}]}))
+    write("scene", "near_minimal.json",
+          '{"format": "stripemux-scene/1", "objects": [{"shape": {"type": "plane"}}]}')
+
+
+def rvl(values):
+    """RVL as docs/protocol.md describes it (firmware/protocol/src/rvl.cpp writes the same)."""
+    nibbles = []
+
+    def code(value):
+        while True:
+            nibble = value & 7
+            value >>= 3
+            nibbles.append(nibble | (8 if value else 0))
+            if not value:
+                return
+
+    previous = 0
+    i = 0
+    while i < len(values):
+        zeros = 0
+        while i < len(values) and values[i] == 0:
+            zeros, i = zeros + 1, i + 1
+        start = i
+        while i < len(values) and values[i] != 0:
+            i += 1
+        code(zeros)
+        code(i - start)
+        for value in values[start:i]:
+            delta = value - previous
+            code(((delta << 1) ^ (delta >> 31)) & 0xFFFFFFFF)
+            previous = value
+    if len(nibbles) % 2:
+        nibbles.append(0)
+    return bytes(nibbles[k] << 4 | nibbles[k + 1] for k in range(0, len(nibbles), 2))
+
+
+def range_frame(camera, compression, width, height, depth):
+    return struct.pack("<BBHHQqqII", camera, compression, width, height, 7, 1000, 2000,
+                       100000, 850) + depth
+
+
+def range_seeds():
+    width, height = 5, 3
+    values = [0 if k % 4 == 0 else 9000 + 37 * k for k in range(width * height)]
+    # The announcement the target reads first: cameras - 1, width - 1 and height - 1 (u16 LE).
+    announce = struct.pack("<BHH", 1, width - 1, height - 1)
+    raw = struct.pack(f"<{width * height}H", *values)
+    write("range_frame", "raw_5x3.bin", announce + range_frame(1, 0, width, height, raw))
+    write("range_frame", "rvl_5x3.bin", announce + range_frame(0, 1, width, height, rvl(values)))
+    write("range_frame", "rvl_zeros_5x3.bin",
+          announce + range_frame(0, 1, width, height, rvl([0] * (width * height))))
+    write("range_frame", "near_claims_65535x65535.bin",
+          announce + range_frame(0, 1, 65535, 65535, b""))
+    write("range_frame", "near_camera_2_of_2.bin", announce + range_frame(2, 1, width, height,
+                                                                          rvl(values)))
+
+    # The protocol target: a first byte with bit 7 set asks it to seal [type, length u16,
+    # payload] records into messages with correct headers.
+    def record(kind, payload):
+        return struct.pack("<BH", kind, len(payload)) + payload
+    hello = struct.pack("<H", 14) + b"stripemux test"
+    frames = (record(1, hello) + record(5, range_frame(0, 1, width, height, rvl(values))) +
+              record(6, b"") + record(5, range_frame(1, 0, width, height, raw)))
+    write("protocol", "sealed_hello_frames.bin", b"\x87" + frames)
+    write("protocol", "sealed_frame_claims_65535.bin",
+          b"\x90" + record(5, range_frame(0, 1, 65535, 65535, b"\x00")))
+
+
+def main():
+    for target in ("protocol", "rig", "board", "scene", "png", "range_frame"):
+        shutil.rmtree(CORPUS / target, ignore_errors=True)
+        (CORPUS / target).mkdir(parents=True)
+    FILES.mkdir(exist_ok=True)
+    checker = [bytes(sum(((255 * ((x + y) % 2),) * 3 for x in range(8)), ())) for y in range(8)]
+    (FILES / "texture.png").write_bytes(png(8, 8, 2, 8, checker))
+    png_seeds()
+    json_seeds()
+    range_seeds()
+
+
+if __name__ == "__main__":
+    main()
