@@ -93,5 +93,22 @@ TEST_F(CliHostileDevice, BoardNameThatIsNotAnIdIsRefused) {
   EXPECT_EQ((result.out + result.err).find('\x1b'), std::string::npos) << result.err;
 }
 
+// Given a device that announces 4096x4096 images while its rig's camera is 640x480, when `info`
+// connects, then it refuses the device: range frames are checked against the announcement, so
+// the two must agree.
+TEST_F(CliHostileDevice, AnnouncementThatDisagreesWithTheRigIsRefused) {
+  test::FakeDevice device({.board = "fake",
+                           .firmwareVersion = "1.0",
+                           .rigJson = exampleRigWith("", ""),
+                           .width = 4096,
+                           .height = 4096,
+                           .framesPerStart = 0});
+  const auto result = test::runCli({"info", "--device", device.address()});
+  EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
+  EXPECT_NE(result.err.find("announced 4096x4096 images, but its rig's cam0 is 640x480"),
+            std::string::npos)
+      << result.err;
+}
+
 }  // namespace
 }  // namespace smx::host

@@ -1,6 +1,8 @@
 #include "device_client.hpp"
 
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include "smx/config/identifier.hpp"
 #include "smx/hal/steady_clock.hpp"
@@ -29,6 +31,26 @@ std::string deviceError(std::span<const std::byte> payload) {
            "; it serves one host at a time: try again when that host is done";
   }
   return "the device refused: " + std::string(error->text);
+}
+
+// The capabilities announce counts and a size that the range frames are checked against; they
+// must be the rig's, or a device could announce one thing and describe another.
+std::optional<std::string> announcementMismatch(const DeviceInfo& info) {
+  const auto& rig = info.rig;
+  if (static_cast<std::size_t>(info.cameras) != rig.cameras.size() ||
+      static_cast<std::size_t>(info.projectors) != rig.projectors.size()) {
+    return "the device announced " + std::to_string(info.cameras) + " cameras and " +
+           std::to_string(info.projectors) + " projectors, but its rig has " +
+           std::to_string(rig.cameras.size()) + " and " + std::to_string(rig.projectors.size());
+  }
+  for (const auto& camera : rig.cameras) {
+    if (camera.width != info.width || camera.height != info.height) {
+      return "the device announced " + std::to_string(info.width) + "x" +
+             std::to_string(info.height) + " images, but its rig's " + camera.id + " is " +
+             std::to_string(camera.width) + "x" + std::to_string(camera.height);
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -104,6 +126,9 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
     return Fail(where + ": the device's rig is invalid: " + rig.error().message());
   }
   info.rig = std::move(*rig);
+  if (auto mismatch = announcementMismatch(info)) {
+    return Fail(where + ": " + *mismatch);
+  }
   return client;
 }
 
