@@ -400,9 +400,10 @@ TEST_F(FirmwareSim, ASecondHostIsToldTheDeviceIsBusyAndTheFirstKeepsStreaming) {
 // device disconnects it after the timeout, and another host is served.
 TEST_F(FirmwareSim, AHostSilentWhileNotStreamingIsDroppedAfterTheIdleTimeout) {
   RunningDevice running(1, idleTimeout(300'000'000));
+  // Before connect: the device's idle time starts at the hello, which connect() sends.
+  const auto start = std::chrono::steady_clock::now();
   auto silent = host::DeviceClient::connect(running.address(), 3000ms);
   ASSERT_TRUE(silent.has_value()) << silent.error();
-  const auto start = std::chrono::steady_clock::now();
   std::optional<std::string> closed;
   while (!closed && std::chrono::steady_clock::now() - start < 5s) {
     if (auto event = silent->next(100ms); !event) {
