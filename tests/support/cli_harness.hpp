@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,6 +26,17 @@ inline CliRun runCli(const std::vector<std::string>& args) {
   std::ostringstream err;
   const int code = host::runCli(args, {out, err});
   return {code, out.str(), err.str()};
+}
+
+// The text of `file` with the first occurrence of `from` replaced by `to` (unchanged for an
+// empty `from`): one field of a shipped rig or board made wrong.
+inline std::string textWith(const std::filesystem::path& file, const std::string& from,
+                            const std::string& to) {
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test bug: " << from << " not in " << file;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
 }
 
 class CliTest : public ::testing::Test {

@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -19,11 +17,18 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string exampleRigWith(const std::string& from, const std::string& to) {
-  std::ifstream in(smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << "test bug: " << from;
-  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  return test::textWith(smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json", from, to);
+}
+
+// A device that tells the truth: the example rig, its size, two frames per start. Tests make one
+// field of it lie.
+test::FakeDeviceScript honestDevice() {
+  return {.board = "fake",
+          .firmwareVersion = "1.0",
+          .rigJson = exampleRigWith("", ""),
+          .width = 640,
+          .height = 480,
+          .framesPerStart = 2};
 }
 
 class CliHostileDevice : public test::CliTest {};
@@ -35,12 +40,9 @@ TEST_F(CliHostileDevice, CameraIdThatIsAPathIsRefusedAndNothingIsWritten) {
   const auto work = dir_ / "a" / "b";
   fs::create_directories(work);
   const std::string escaped = "smx_hostile_device_escaped";
-  test::FakeDevice device({.board = "fake",
-                           .firmwareVersion = "0.0.0",
-                           .rigJson = exampleRigWith("\"cam0\"", "\"../../" + escaped + "\""),
-                           .width = 640,
-                           .height = 480,
-                           .framesPerStart = 2});
+  auto script = honestDevice();
+  script.rigJson = exampleRigWith("\"cam0\"", "\"../../" + escaped + "\"");
+  test::FakeDevice device(script);
   const auto result = test::runCli({"stream", "--device", device.address(), "--out",
                                     (work / "out").string(), "--frames", "1", "--timeout", "10"});
   EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
@@ -55,13 +57,11 @@ TEST_F(CliHostileDevice, CameraIdThatIsAPathIsRefusedAndNothingIsWritten) {
 // terminal: each is shown as \xNN.
 TEST_F(CliHostileDevice, EscapeSequencesFromTheDeviceNeverReachTheTerminal) {
   for (const std::string command : {"info", "stream"}) {
-    test::FakeDevice device({.board = "fake",
-                             .firmwareVersion = "evil\x1b]0;owned\x07\xc2\x9b"
-                                                "2J",
-                             .rigJson = exampleRigWith("", ""),
-                             .width = 640,
-                             .height = 480,
-                             .framesPerStart = 2});
+    auto script = honestDevice();
+    script.firmwareVersion =
+        "evil\x1b]0;owned\x07\xc2\x9b"
+        "2J";
+    test::FakeDevice device(script);
     std::vector<std::string> args = {command, "--device", device.address()};
     if (command == "stream") {
       args.insert(args.end(),
@@ -81,12 +81,9 @@ TEST_F(CliHostileDevice, EscapeSequencesFromTheDeviceNeverReachTheTerminal) {
 // Given a device whose board name is not an id (here an escape sequence), when `info` connects,
 // then it refuses the device naming the board name, and the message shows the name escaped.
 TEST_F(CliHostileDevice, BoardNameThatIsNotAnIdIsRefused) {
-  test::FakeDevice device({.board = "evil\x1b[2J",
-                           .firmwareVersion = "1.0",
-                           .rigJson = exampleRigWith("", ""),
-                           .width = 640,
-                           .height = 480,
-                           .framesPerStart = 0});
+  auto script = honestDevice();
+  script.board = "evil\x1b[2J";
+  test::FakeDevice device(script);
   const auto result = test::runCli({"info", "--device", device.address()});
   EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
   EXPECT_NE(result.err.find("the device's board name"), std::string::npos) << result.err;
@@ -97,12 +94,10 @@ TEST_F(CliHostileDevice, BoardNameThatIsNotAnIdIsRefused) {
 // connects, then it refuses the device: range frames are checked against the announcement, so
 // the two must agree.
 TEST_F(CliHostileDevice, AnnouncementThatDisagreesWithTheRigIsRefused) {
-  test::FakeDevice device({.board = "fake",
-                           .firmwareVersion = "1.0",
-                           .rigJson = exampleRigWith("", ""),
-                           .width = 4096,
-                           .height = 4096,
-                           .framesPerStart = 0});
+  auto script = honestDevice();
+  script.width = 4096;
+  script.height = 4096;
+  test::FakeDevice device(script);
   const auto result = test::runCli({"info", "--device", device.address()});
   EXPECT_EQ(result.code, kExitDeviceOrIo) << result.err;
   EXPECT_NE(result.err.find("announced 4096x4096 images, but its rig's cam0 is 640x480"),

@@ -33,11 +33,7 @@ const fs::path kRig = smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json";
 
 // rig_2proj_1cam.json with the first occurrence of `from` replaced by `to`.
 std::string exampleRigWith(const std::string& from, const std::string& to) {
-  std::ifstream in(kRig);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << "test bug: " << from;
-  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  return test::textWith(kRig, from, to);
 }
 
 // Every regular file below `dir`.

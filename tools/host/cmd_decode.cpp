@@ -17,7 +17,7 @@
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "demux_debug.hpp"
-#include "output_folder.hpp"
+#include "output_files.hpp"
 #include "point_cloud.hpp"
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/sim/ply_io.hpp"
@@ -72,12 +72,6 @@ std::expected<void, Failure> writeOrFail(const std::expected<void, std::string>&
   return {};
 }
 
-std::expected<void, Failure> writePng(OutputFolder& folder, const std::string& name,
-                                      const sim::RgbImage& image) {
-  return writeOrFail(folder.write(
-      name, [&](const fs::path& file) { return sim::writePngRgb8(file, image.view()); }));
-}
-
 std::expected<void, Failure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
                                         const algo::Rig& rig, algo::CameraPipeline& pipeline) {
   for (int p = 0; p < pipeline.projectors(); ++p) {
@@ -85,26 +79,19 @@ std::expected<void, Failure> writeDebug(OutputFolder& dir, const algo::Camera& c
     if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
       return ok;
     }
-    if (auto ok = writePng(dir, tag + ".stripes.png", renderStripes(pipeline.stripe(p))); !ok) {
+    if (auto ok = writeOrFail(
+            writePngRgb8(dir, tag + ".stripes.png", renderStripes(pipeline.stripe(p)).view()));
+        !ok) {
       return ok;
     }
-    if (auto ok = writePng(dir, tag + ".depth.png", renderDepth(pipeline.depth(p))); !ok) {
+    if (auto ok = writeOrFail(
+            writePngRgb8(dir, tag + ".depth.png", renderDepth(pipeline.depth(p)).view()));
+        !ok) {
       return ok;
     }
   }
-  return writePng(dir, camera.id + ".depth.png", renderDepth(pipeline.merged()));
-}
-
-std::expected<void, Failure> writeDepth(OutputFolder& folder, const std::string& name,
-                                        algo::ConstDepthPlane depth) {
   return writeOrFail(
-      folder.write(name, [&](const fs::path& file) { return sim::writePngGray16(file, depth); }));
-}
-
-std::expected<void, Failure> writePly(OutputFolder& folder, const std::string& name,
-                                      std::span<const sim::PlyPoint> points) {
-  return writeOrFail(
-      folder.write(name, [&](const fs::path& file) { return sim::writePlyPoints(file, points); }));
+      writePngRgb8(dir, camera.id + ".depth.png", renderDepth(pipeline.merged()).view()));
 }
 
 // The output folders of a run: --out, and --debug when given.
@@ -170,7 +157,7 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
   for (int p = 0; p < pipeline->projectors(); ++p) {
     const std::string name =
         rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id + ".depth.png";
-    if (auto w = writeDepth(outputs.out, name, pipeline->depth(p)); !w) {
+    if (auto w = writeOrFail(writePngGray16(outputs.out, name, pipeline->depth(p))); !w) {
       return std::unexpected(w.error());
     }
     const algo::DecodeStats& stats = pipeline->decodeStats(p);
@@ -181,13 +168,13 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
                      {"decoded_boundary_pixels", stats.decodedPixels}});
   }
   const std::string depthName = camera.id + ".depth.png";
-  if (auto w = writeDepth(outputs.out, depthName, pipeline->merged()); !w) {
+  if (auto w = writeOrFail(writePngGray16(outputs.out, depthName, pipeline->merged())); !w) {
     return std::unexpected(w.error());
   }
   const auto points =
       depthToWorldPoints(camera, pipeline->merged(), opts.depthUnitM, image->view());
   const std::string plyName = camera.id + ".ply";
-  if (auto w = writePly(outputs.out, plyName, points); !w) {
+  if (auto w = writeOrFail(writePlyPoints(outputs.out, plyName, points)); !w) {
     return std::unexpected(w.error());
   }
   if (outputs.debug) {
@@ -249,8 +236,8 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
       return fail(ok.error().code, ok.error().message);
     }
   }
-  if (auto ok = writePly(outputs.out, "merged.ply", merged); !ok) {
-    return fail(ok.error().code, ok.error().message);
+  if (auto ok = writePlyPoints(outputs.out, "merged.ply", merged); !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
   }
   const Json meta = {{"format", "stripemux-decode/1"}, {"depth_unit_m", opts.depthUnitM},
                      {"rig", opts.rig.string()},       {"cameras", cameras},
@@ -260,10 +247,11 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
       !ok) {
     return fail(kExitDeviceOrIo, ok.error());
   }
-  for (OutputFolder* folder : {&outputs.out, outputs.debug ? &*outputs.debug : nullptr}) {
-    if (auto ok = folder != nullptr ? folder->commit() : std::expected<void, std::string>{}; !ok) {
-      return fail(kExitDeviceOrIo, ok.error());
-    }
+  if (auto ok = outputs.out.commit(); !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
+  }
+  if (auto ok = outputs.debug ? outputs.debug->commit() : std::expected<void, std::string>{}; !ok) {
+    return fail(kExitDeviceOrIo, ok.error());
   }
   io.out << report.str() << "wrote " << outputs.out.pathOf("merged.ply").string() << " ("
          << merged.size() << " points) and " << outputs.out.pathOf("meta.json").string() << "\n";

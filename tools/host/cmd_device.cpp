@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "device_client.hpp"
-#include "output_folder.hpp"
+#include "output_files.hpp"
 #include "point_cloud.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/wire.hpp"
@@ -241,30 +241,22 @@ class FrameWriter {
   FrameWriter(const StreamOptions& opts, const DeviceInfo& info, OutputFolder& out)
       : opts_(opts), info_(info), out_(out) {}
 
+  // `frame` passed receiveRangeFrame: its camera is one of the rig's (the announcement is the
+  // rig's, DeviceClient::connect) and its size the announced one.
   std::expected<void, std::string> write(const ReceivedFrame& frame) {
     const auto cameraIndex = static_cast<std::size_t>(frame.header.camera);
-    if (cameraIndex >= info_.rig.cameras.size()) {
-      return std::unexpected("range frame of camera " + std::to_string(cameraIndex) +
-                             ", but the device has " + std::to_string(info_.rig.cameras.size()));
-    }
     const algo::Camera& camera = info_.rig.cameras[cameraIndex];
     const auto depth =
         *algo::ConstDepthPlane::packed(frame.depth, frame.header.width, frame.header.height);
     // camera.id passed the rig's id rules (parseRig), and the folder checks the name again.
     const std::string stem = camera.id + "_" + std::to_string(frame.header.frame);
-    if (auto ok =
-            out_.write(stem + ".depth.png",
-                       [&](const fs::path& file) { return sim::writePngGray16(file, depth); });
-        !ok) {
+    if (auto ok = writePngGray16(out_, stem + ".depth.png", depth); !ok) {
       return ok;
     }
     const double unitM = frame.header.depthUnitNm * 1e-9;
     auto points = depthToWorldPoints(camera, depth, unitM);
     if (!opts_.noPly) {
-      if (auto ok =
-              out_.write(stem + ".ply",
-                         [&](const fs::path& file) { return sim::writePlyPoints(file, points); });
-          !ok) {
+      if (auto ok = writePlyPoints(out_, stem + ".ply", points); !ok) {
         return ok;
       }
     }
@@ -288,17 +280,11 @@ class FrameWriter {
       const auto depth =
           *algo::ConstDepthPlane::packed(kept.depth, kept.header.width, kept.header.height);
       const std::string id = info_.rig.cameras[camera].id;
-      if (auto ok = out_.write(id + ".preview.png",
-                               [&](const fs::path& file) {
-                                 return sim::writePngRgb8(file, renderDepth(depth).view());
-                               });
-          !ok) {
+      if (auto ok = writePngRgb8(out_, id + ".preview.png", renderDepth(depth).view()); !ok) {
         return std::unexpected(ok.error());
       }
     }
-    if (auto ok = out_.write(
-            "merged.ply", [&](const fs::path& file) { return sim::writePlyPoints(file, merged); });
-        !ok) {
+    if (auto ok = writePlyPoints(out_, "merged.ply", merged); !ok) {
       return std::unexpected(ok.error());
     }
     return "merged.ply (" + std::to_string(merged.size()) + " points of frame " +

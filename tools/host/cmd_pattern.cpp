@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_folder.hpp"
+#include "output_files.hpp"
 #include "smx/algo/pattern_image.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
@@ -45,10 +45,7 @@ int runPattern(const PatternOptions& opts, const CliStreams& io) {
       return kExitBadInput;
     }
     const std::string name = projector.id + ".png";
-    if (auto written = out->write(
-            name,
-            [&](const std::filesystem::path& file) { return sim::writePngRgb8(file, *view); });
-        !written) {
+    if (auto written = writePngRgb8(*out, name, *view); !written) {
       io.err << "stripemux pattern: " << written.error() << "\n";
       return kExitDeviceOrIo;
     }

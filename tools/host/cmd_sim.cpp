@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_folder.hpp"
+#include "output_files.hpp"
 #include "smx/protocol/rig_json.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/pfm_io.hpp"
@@ -92,31 +92,28 @@ struct CameraTruth {
 };
 
 template <class Pixel>
-std::expected<void, std::string> writePfm(OutputFolder& out, const std::string& name,
-                                          const Plane<Pixel>& plane) {
-  return out.write(name, [&](const fs::path& file) { return sim::writePfm(file, plane.view); });
+std::expected<void, std::string> writePlane(OutputFolder& out, const std::string& name,
+                                            const Plane<Pixel>& plane) {
+  return writePfm<Pixel>(out, name, plane.view);
 }
 
 std::expected<void, std::string> writeTruth(CameraTruth& truth, const algo::Rig& rig,
                                             OutputFolder& out, const std::string& camTag) {
-  if (auto r = writePfm(out, camTag + ".depth.pfm", truth.depth); !r) {
+  if (auto r = writePlane(out, camTag + ".depth.pfm", truth.depth); !r) {
     return r;
   }
-  if (auto r = writePfm(out, camTag + ".normal.pfm", truth.normal); !r) {
+  if (auto r = writePlane(out, camTag + ".normal.pfm", truth.normal); !r) {
     return r;
   }
   for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
     const auto base = rig.projectors[p].id + "." + camTag;
-    if (auto r = out.write(
-            base + ".lit.png",
-            [&](const fs::path& file) { return sim::writePngGray8(file, truth.lit[p].view); });
-        !r) {
+    if (auto r = writePngGray8(out, base + ".lit.png", truth.lit[p].view); !r) {
       return r;
     }
     for (const auto& [suffix, plane] :
          {std::pair{".u.pfm", &truth.u[p]}, std::pair{".v.pfm", &truth.v[p]},
           std::pair{".stripe.pfm", &truth.stripe[p]}}) {
-      if (auto r = writePfm(out, base + suffix, *plane); !r) {
+      if (auto r = writePlane(out, base + suffix, *plane); !r) {
         return r;
       }
     }
@@ -175,10 +172,7 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count();
-      if (auto r =
-              out->write(tag + ".png",
-                         [&](const fs::path& file) { return sim::writePngRgb8(file, image.view); });
-          !r) {
+      if (auto r = writePngRgb8(*out, tag + ".png", image.view); !r) {
         return fail(kExitDeviceOrIo, r.error());
       }
       if (truth) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "colour_map.hpp"
+#include "output_files.hpp"
 
 namespace smx::host {
 
@@ -95,11 +96,7 @@ std::expected<void, std::string> writeDemuxDebug(OutputFolder& dir, const std::s
        renderDirections(demux.directions(projector), demux.boundaries(projector))},
   };
   for (const auto& [suffix, image] : images) {
-    if (auto ok = dir.write(tag + suffix,
-                            [&](const std::filesystem::path& file) {
-                              return sim::writePngRgb8(file, image.view());
-                            });
-        !ok) {
+    if (auto ok = writePngRgb8(dir, tag + suffix, image.view()); !ok) {
       return ok;
     }
   }

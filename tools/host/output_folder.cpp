@@ -8,16 +8,14 @@
 #include <system_error>
 #include <utility>
 
+#include "smx/config/identifier.hpp"
+
 namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
 
 constexpr std::size_t kMaxFileName = 128;
-
-bool isAlnum(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
-}
 
 // The folders create_directories(dir) would make, outermost first.
 std::vector<fs::path> missingFolders(const fs::path& dir) {
@@ -58,11 +56,11 @@ std::optional<std::string> fileNameProblem(std::string_view name) {
     return "an output file name must be 1 to " + std::to_string(kMaxFileName) +
            " characters long, got " + std::to_string(name.size());
   }
-  if (!isAlnum(name.front())) {
+  if (!config::isIdentifierStart(name.front())) {
     return "an output file name must start with a letter or digit";
   }
   for (const char c : name) {
-    if (!isAlnum(c) && c != '_' && c != '-' && c != '.') {
+    if (!config::isIdentifierChar(c)) {
       return "an output file name may hold only A-Z a-z 0-9 _ - . (no folder, no control "
              "character)";
     }

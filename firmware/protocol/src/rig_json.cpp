@@ -322,22 +322,28 @@ Status checkPattern(const algo::Projector& projector, const std::string& path) {
   return {};
 }
 
-Status checkCount(std::size_t n, const std::string& path, std::string_view what, std::size_t most) {
+// One of the rig's device lists: its key, what one device is called, and how many there may be.
+struct DeviceList {
+  std::string_view key;
+  std::string_view what;
+  std::size_t most;
+  std::string_view why;  // of the bound, for the message; may be empty
+};
+constexpr DeviceList kCameraList = {"cameras", "camera", kMaxCameras, ""};
+constexpr DeviceList kProjectorList = {
+    "projectors", "projector", algo::kMaxProjectors,
+    " (the method separates up to 3 pattern orientations in one image)"};
+
+Status checkCount(std::size_t n, const DeviceList& list) {
+  const std::string path(list.key);
   if (n == 0) {
-    return fail(path, "at least one " + std::string(what) + " is required, got none");
+    return fail(path, "at least one " + std::string(list.what) + " is required, got none");
   }
-  if (n > most) {
-    return fail(path, "at most " + std::to_string(most) + " " + std::string(what) + "s" +
-                          (what == "projector" ? " (the method separates up to 3 pattern "
-                                                 "orientations in one image)"
-                                               : "") +
-                          ", got " + std::to_string(n));
+  if (n > list.most) {
+    return fail(path, "at most " + std::to_string(list.most) + " " + std::string(list.what) + "s" +
+                          std::string(list.why) + ", got " + std::to_string(n));
   }
   return {};
-}
-
-std::size_t mostOf(std::string_view what) {
-  return what == "projector" ? std::size_t{algo::kMaxProjectors} : kMaxCameras;
 }
 
 // --- reading: JSON structure -> Rig ---
@@ -438,17 +444,18 @@ Status readDevice(const Json& obj, const std::string& path, IdRegistry& ids, Dev
 }
 
 template <class Device>
-std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, std::string_view key,
-                                                         std::string_view what, IdRegistry& ids) {
-  const std::string path(key);
-  const auto it = doc.find(key);
+std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, const DeviceList& list,
+                                                         IdRegistry& ids) {
+  const std::string path(list.key);
+  const std::string what(list.what);
+  const auto it = doc.find(list.key);
   if (it == doc.end()) {
     return fail(path, "required field is missing");
   }
   if (!it->is_array()) {
-    return fail(path, "must be an array of " + std::string(what) + "s, got " + describe(*it));
+    return fail(path, "must be an array of " + what + "s, got " + describe(*it));
   }
-  if (auto s = checkCount(it->size(), path, what, mostOf(what)); !s) {
+  if (auto s = checkCount(it->size(), list); !s) {
     return std::unexpected(s.error());
   }
   std::vector<Device> devices(it->size());
@@ -456,7 +463,7 @@ std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, std::s
     const Json& obj = (*it)[i];
     const std::string at = element(path, i);
     if (!obj.is_object()) {
-      return fail(at, "must be an object (one " + std::string(what) + "), got " + describe(obj));
+      return fail(at, "must be an object (one " + what + "), got " + describe(obj));
     }
     if (auto s = readDevice(obj, at, ids, devices[i]); !s) {
       return std::unexpected(s.error());
@@ -472,12 +479,12 @@ std::expected<algo::Rig, RigError> parseRigImpl(std::string_view text) {
   }
   IdRegistry ids;
   algo::Rig rig;
-  auto cameras = readDevices<algo::Camera>(*doc, "cameras", "camera", ids);
+  auto cameras = readDevices<algo::Camera>(*doc, kCameraList, ids);
   if (!cameras) {
     return std::unexpected(cameras.error());
   }
   rig.cameras = std::move(*cameras);
-  auto projectors = readDevices<algo::Projector>(*doc, "projectors", "projector", ids);
+  auto projectors = readDevices<algo::Projector>(*doc, kProjectorList, ids);
   if (!projectors) {
     return std::unexpected(projectors.error());
   }
@@ -553,7 +560,7 @@ std::expected<algo::Rig, RigError> loadRig(const std::filesystem::path& path) {
 std::expected<void, RigError> validateRig(const algo::Rig& rig) {
   try {
     IdRegistry ids;
-    if (auto s = checkCount(rig.cameras.size(), "cameras", "camera", kMaxCameras); !s) {
+    if (auto s = checkCount(rig.cameras.size(), kCameraList); !s) {
       return s;
     }
     for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
@@ -561,8 +568,7 @@ std::expected<void, RigError> validateRig(const algo::Rig& rig) {
         return s;
       }
     }
-    if (auto s = checkCount(rig.projectors.size(), "projectors", "projector", algo::kMaxProjectors);
-        !s) {
+    if (auto s = checkCount(rig.projectors.size(), kProjectorList); !s) {
       return s;
     }
     for (std::size_t i = 0; i < rig.projectors.size(); ++i) {

@@ -5,14 +5,6 @@
 namespace smx::config {
 namespace {
 
-bool isAlnum(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
-}
-
-bool isIdentifierChar(char c) {
-  return isAlnum(c) || c == '_' || c == '-' || c == '.';
-}
-
 // The id as JSON with every non-ASCII byte escaped, cut to a readable length: the message
 // itself must carry no control characters or escape sequences.
 std::string shown(std::string_view id) {
@@ -34,7 +26,7 @@ std::optional<std::string> identifierProblem(std::string_view id) {
   if (id.size() > kMaxIdentifierLength) {
     return "is " + std::to_string(id.size()) + " characters long" + rule;
   }
-  if (!isAlnum(id.front())) {
+  if (!isIdentifierStart(id.front())) {
     return "must start with a letter or digit, got " + shown(id) + rule;
   }
   for (const char c : id) {

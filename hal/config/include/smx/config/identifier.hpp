@@ -13,6 +13,14 @@ namespace smx::config {
 
 inline constexpr std::size_t kMaxIdentifierLength = 32;
 
+// The alphabet, for names built from ids (output file names) that follow the same rule.
+[[nodiscard]] constexpr bool isIdentifierStart(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+[[nodiscard]] constexpr bool isIdentifierChar(char c) {
+  return isIdentifierStart(c) || c == '_' || c == '-' || c == '.';
+}
+
 // What is wrong with `id` as an identifier ("must start with a letter or digit, got \".x\""), or
 // nothing when it is one.
 [[nodiscard]] std::optional<std::string> identifierProblem(std::string_view id);
