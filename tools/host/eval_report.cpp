@@ -206,8 +206,9 @@ struct Writer {
     }
     md << "## The paper's Table 2, measured\n\n"
           "A sphere (radius 15 cm) with stations at the corners of a regular tetrahedron around "
-          "it, 0.9 m out; station i holds camera i and projector i (`tools/host/eval/table2.hpp` "
-          "has the layout). nPmC uses the first n projectors and m cameras, all patterns on at "
+          "it, 0.9 m out; station i holds camera i and projector i "
+          "(`tools/host/eval/include/smx/eval/table2.hpp` has the layout). nPmC uses the first n "
+          "projectors and m cameras, all patterns on at "
           "once. Relative amount: inlier pixels summed over every projector–camera pair, in the "
           "paper's unit (one scan of the whole sphere = 100 %: the 1P1C amount is its "
           "completeness). Completeness: the share of the sphere's surface on which some inlier "
@@ -291,7 +292,8 @@ struct Writer {
     if (!r.directColour.empty()) {
       md << "### Direct colour estimation against orientation demultiplexing\n\n"
             "The single-projector decoder's front end (hue classification, "
-            "`algo/direct_colour.hpp`) on the superposed image, given the demultiplexer's own "
+            "`algo/include/smx/algo/direct_colour.hpp`) on the superposed image, given the "
+            "demultiplexer's own "
             "directions, so only the colour decision differs. Boundaries of each projector "
             "scored against the truth where exactly n patterns light the surface.\n\n"
             "| scene | projector | lit by | demux recall | demux class accuracy | direct recall "
