@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <filesystem>
+#include <iterator>
 
 #include "alloc_counter.hpp"
 #include "fake_v4l2_driver.hpp"
@@ -371,6 +373,41 @@ TEST_F(V4l2CameraTest, DestructionStopsStreamingAndClosesTheDevice) {
   EXPECT_FALSE(driver_.streaming());
   EXPECT_EQ(driver_.mappedCount(), 0);
   EXPECT_EQ(driver_.openFds(), 0);
+}
+
+TEST_F(V4l2CameraTest, AReopenThatFailsAfterOpeningClosesTheDescriptor) {
+  auto camera = streaming(PixelFormat::kRgb24);
+  driver_.unplug();
+  ASSERT_FALSE(camera->acquire(kTimeoutNs));
+  // Given a device that comes back unable to capture
+  driver_.capabilities = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING;
+  driver_.plug();
+  const int opensBefore = driver_.opens();
+  // Then reopen opens it, refuses it and closes it again
+  EXPECT_EQ(camera->reopen().error().code, HalErrc::kNotSupported);
+  EXPECT_EQ(driver_.opens(), opensBefore + 1);
+  EXPECT_EQ(driver_.openFds(), 0);
+  EXPECT_TRUE(camera->lost());
+}
+
+// Descriptors of this process, counted from /proc/self/fd.
+std::ptrdiff_t processFds() {
+  return std::distance(std::filesystem::directory_iterator("/proc/self/fd"),
+                       std::filesystem::directory_iterator{});
+}
+
+TEST(V4l2CameraSystemTest, ANonV4l2DeviceIsRefusedWithoutLeakingItsDescriptor) {
+  // Given files that open but are no V4L2 devices, through the real system calls
+  SystemV4l2Io io;
+  const std::ptrdiff_t before = processFds();
+  for (int i = 0; i < 3; ++i) {
+    auto devNull = V4l2Camera::create("/dev/null", "cam0", 4, io);
+    ASSERT_FALSE(devNull);
+    EXPECT_NE(devNull.error().find("/dev/null is not a V4L2 device"), std::string::npos)
+        << devNull.error();
+  }
+  // Then every descriptor opened on the way was closed
+  EXPECT_EQ(processFds(), before);
 }
 
 TEST_F(V4l2CameraTest, CorruptAndShortFramesAreSkipped) {

@@ -62,7 +62,7 @@ void FakeDevice::serve() {
   if (stop_) {
     return;
   }
-  const net::UniqueFd client(::accept(listener_.get(), nullptr, nullptr));
+  const hal::UniqueFd client(::accept(listener_.get(), nullptr, nullptr));
   if (!client.valid()) {
     return;
   }

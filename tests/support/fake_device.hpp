@@ -5,7 +5,7 @@
 #include <string>
 #include <thread>
 
-#include "smx/net/unique_fd.hpp"
+#include "smx/hal/unique_fd.hpp"
 
 // A device that says whatever a test tells it to: capabilities with any board name and rig, range
 // frames, statistics. It stands in for a hostile or broken device (devices are unauthenticated,
@@ -35,7 +35,7 @@ class FakeDevice {
   void serve();
 
   FakeDeviceScript script_;
-  net::UniqueFd listener_;
+  hal::UniqueFd listener_;
   std::uint16_t port_ = 0;
   std::atomic<bool> stop_{false};
   std::thread thread_;

@@ -36,8 +36,8 @@ std::unique_ptr<TcpLink> loopbackLink() {
 }
 
 // A plain blocking socket connected to 127.0.0.1:port; its own port in `localPort`.
-UniqueFd connectRaw(std::uint16_t port, std::uint16_t& localPort) {
-  UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
+hal::UniqueFd connectRaw(std::uint16_t port, std::uint16_t& localPort) {
+  hal::UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
   sockaddr_in to{};
   to.sin_family = AF_INET;
   to.sin_port = htons(port);
@@ -79,11 +79,11 @@ std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>> readMess
 TEST(TcpLink, ASecondHostIsToldBusyWithTheHolderAndTheFirstIsUnaffected) {
   const auto link = loopbackLink();
   std::uint16_t firstPort = 0;
-  const UniqueFd first = connectRaw(link->port(), firstPort);
+  const hal::UniqueFd first = connectRaw(link->port(), firstPort);
   ASSERT_TRUE(link->acceptClient(2'000'000'000).has_value());
 
   std::uint16_t secondPort = 0;
-  const UniqueFd second = connectRaw(link->port(), secondPort);
+  const hal::UniqueFd second = connectRaw(link->port(), secondPort);
   const auto deadline = Clock::now() + 5s;
   while (link->refusedClients() == 0 && Clock::now() < deadline) {
     ASSERT_TRUE(link->waitForIo(false, 10'000'000).has_value());
@@ -175,7 +175,7 @@ TEST(TcpLink, ServesIpv6HostsAndIpv4OnesOnEveryAddress) {
   ASSERT_TRUE((*link)->acceptClient(2'000'000'000).has_value());
 
   std::uint16_t secondPort = 0;
-  const UniqueFd second = connectRaw((*link)->port(), secondPort);
+  const hal::UniqueFd second = connectRaw((*link)->port(), secondPort);
   const auto deadline = Clock::now() + 5s;
   while ((*link)->refusedClients() == 0 && Clock::now() < deadline) {
     ASSERT_TRUE((*link)->waitForIo(false, 10'000'000).has_value());

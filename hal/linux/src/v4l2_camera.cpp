@@ -91,33 +91,29 @@ std::expected<std::unique_ptr<V4l2Camera>, std::string> V4l2Camera::create(std::
     return std::unexpected(devicePath + ": buffers must be " + std::to_string(kMinBuffers) + ".." +
                            std::to_string(kMaxBuffers) + ", not " + std::to_string(buffers));
   }
-  const int fd = io.open(devicePath.c_str(), kOpenFlags);
-  if (fd < 0) {
-    return std::unexpected("cannot open " + devicePath + ": " + errnoText(-fd));
+  const int opened = io.open(devicePath.c_str(), kOpenFlags);
+  if (opened < 0) {
+    return std::unexpected("cannot open " + devicePath + ": " + errnoText(-opened));
   }
+  V4l2Fd fd(opened, V4l2Close{&io});
   v4l2_capability capability{};
-  if (const int r = io.ioctl(fd, VIDIOC_QUERYCAP, &capability); r < 0) {
-    io.close(fd);
+  if (const int r = io.ioctl(fd.get(), VIDIOC_QUERYCAP, &capability); r < 0) {
     return std::unexpected(devicePath + " is not a V4L2 device (VIDIOC_QUERYCAP: " + errnoText(-r) +
                            ")");
   }
   if (const char* problem = capabilityProblem(capability); problem != nullptr) {
-    io.close(fd);
     return std::unexpected(devicePath + " (driver " + driverName(capability) + ") " + problem);
   }
   return std::unique_ptr<V4l2Camera>(
-      new V4l2Camera(std::move(devicePath), std::move(cameraId), buffers, fd, io));
+      new V4l2Camera(std::move(devicePath), std::move(cameraId), buffers, std::move(fd), io));
 }
 
 V4l2Camera::~V4l2Camera() {
-  if (fd_ >= 0 && state_ == CameraState::kStreaming) {
+  if (!lost() && state_ == CameraState::kStreaming) {
     int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    (void)io_.ioctl(fd_, VIDIOC_STREAMOFF, &type);
+    (void)io_.ioctl(fd_.get(), VIDIOC_STREAMOFF, &type);
   }
-  freeBuffers();
-  if (fd_ >= 0) {
-    io_.close(fd_);
-  }
+  freeBuffers();  // REQBUFS 0 needs the descriptor, which the member closes after this body
 }
 
 hal::HalResult<hal::CameraFormat> V4l2Camera::configure(const hal::CameraFormat& wanted) {
@@ -155,7 +151,7 @@ hal::HalResult<hal::CameraFormat> V4l2Camera::negotiate(const hal::CameraFormat&
   format.fmt.pix.height = static_cast<std::uint32_t>(wanted.height);
   format.fmt.pix.pixelformat = fourcc(wanted.pixelFormat);
   format.fmt.pix.field = V4L2_FIELD_NONE;
-  if (const int r = io_.ioctl(fd_, VIDIOC_S_FMT, &format); r < 0) {
+  if (const int r = io_.ioctl(fd_.get(), VIDIOC_S_FMT, &format); r < 0) {
     if (deviceGone(r)) {
       return markLost(-r);
     }
@@ -185,7 +181,7 @@ hal::HalResult<hal::CameraFormat> V4l2Camera::negotiate(const hal::CameraFormat&
   parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   parm.parm.capture.timeperframe = {.numerator = 1,
                                     .denominator = static_cast<std::uint32_t>(wanted.fps)};
-  if (const int r = io_.ioctl(fd_, VIDIOC_S_PARM, &parm); r < 0) {
+  if (const int r = io_.ioctl(fd_.get(), VIDIOC_S_PARM, &parm); r < 0) {
     if (deviceGone(r)) {
       return markLost(-r);
     }
@@ -224,7 +220,7 @@ hal::HalResult<void> V4l2Camera::startStreaming() {
   request.count = static_cast<std::uint32_t>(wantedBuffers_);
   request.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   request.memory = V4L2_MEMORY_MMAP;
-  if (const int r = io_.ioctl(fd_, VIDIOC_REQBUFS, &request); r < 0) {
+  if (const int r = io_.ioctl(fd_.get(), VIDIOC_REQBUFS, &request); r < 0) {
     if (deviceGone(r)) {
       return markLost(-r);
     }
@@ -239,7 +235,7 @@ hal::HalResult<void> V4l2Camera::startStreaming() {
   const bool converts = format_.pixelFormat != PixelFormat::kRgb24;
   for (int i = 0; i < bufferCount(); ++i) {
     v4l2_buffer query = mmapBuffer(i);
-    if (const int r = io_.ioctl(fd_, VIDIOC_QUERYBUF, &query); r < 0) {
+    if (const int r = io_.ioctl(fd_.get(), VIDIOC_QUERYBUF, &query); r < 0) {
       freeBuffers();
       return deviceGone(r) ? markLost(-r) : halFail(HalErrc::kIo, "VIDIOC_QUERYBUF failed", -r);
     }
@@ -247,7 +243,7 @@ hal::HalResult<void> V4l2Camera::startStreaming() {
       freeBuffers();
       return halFail(HalErrc::kIo, "a driver buffer is smaller than a frame");
     }
-    auto mapped = io_.mmap(fd_, query.length, query.m.offset);
+    auto mapped = io_.mmap(fd_.get(), query.length, query.m.offset);
     if (!mapped) {
       freeBuffers();
       return halFail(HalErrc::kIo, "cannot map a camera buffer", -mapped.error());
@@ -267,7 +263,7 @@ hal::HalResult<void> V4l2Camera::startStreaming() {
     }
   }
   int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (const int r = io_.ioctl(fd_, VIDIOC_STREAMON, &type); r < 0) {
+  if (const int r = io_.ioctl(fd_.get(), VIDIOC_STREAMON, &type); r < 0) {
     freeBuffers();
     return deviceGone(r) ? markLost(-r) : halFail(HalErrc::kIo, "VIDIOC_STREAMON failed", -r);
   }
@@ -284,7 +280,7 @@ hal::HalResult<void> V4l2Camera::stop() {
   hal::HalResult<void> result;
   if (!lost()) {
     int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    if (const int r = io_.ioctl(fd_, VIDIOC_STREAMOFF, &type); r < 0) {
+    if (const int r = io_.ioctl(fd_.get(), VIDIOC_STREAMOFF, &type); r < 0) {
       result = deviceGone(r) ? markLost(-r) : halFail(HalErrc::kIo, "VIDIOC_STREAMOFF failed", -r);
     }
   }
@@ -311,7 +307,7 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
   for (;;) {
     short revents = 0;
     const std::int64_t leftNs = std::max<std::int64_t>(deadlineNs - io_.nowNs(), 0);
-    const int polled = io_.poll(fd_, POLLIN, leftNs, revents);
+    const int polled = io_.poll(fd_.get(), POLLIN, leftNs, revents);
     if (polled == -EINTR) {
       continue;
     }
@@ -326,7 +322,7 @@ hal::HalResult<hal::CameraFrame> V4l2Camera::acquire(std::int64_t timeoutNs) {
       return markLost(ENODEV);
     }
     v4l2_buffer buffer = mmapBuffer(0);
-    const int r = io_.ioctl(fd_, VIDIOC_DQBUF, &buffer);
+    const int r = io_.ioctl(fd_.get(), VIDIOC_DQBUF, &buffer);
     if (r == -EAGAIN) {
       continue;  // woken without a frame
     }
@@ -436,7 +432,7 @@ hal::HalResult<void> V4l2Camera::release(const hal::CameraFrame& frame) {
 
 hal::HalResult<void> V4l2Camera::queue(int index) {
   v4l2_buffer buffer = mmapBuffer(index);
-  if (const int r = io_.ioctl(fd_, VIDIOC_QBUF, &buffer); r < 0) {
+  if (const int r = io_.ioctl(fd_.get(), VIDIOC_QBUF, &buffer); r < 0) {
     return deviceGone(r) ? markLost(-r) : halFail(HalErrc::kIo, "VIDIOC_QBUF failed", -r);
   }
   return {};
@@ -447,21 +443,20 @@ hal::HalResult<void> V4l2Camera::reopen() {
     return {};
   }
   freeBuffers();  // frames from before the loss are invalid from here on
-  const int fd = io_.open(path_.c_str(), kOpenFlags);
-  if (fd < 0) {
-    return halFail(HalErrc::kDisconnected, "the camera device is still absent", -fd);
+  const int opened = io_.open(path_.c_str(), kOpenFlags);
+  if (opened < 0) {
+    return halFail(HalErrc::kDisconnected, "the camera device is still absent", -opened);
   }
+  V4l2Fd fd(opened, V4l2Close{&io_});
   v4l2_capability capability{};
-  if (const int r = io_.ioctl(fd, VIDIOC_QUERYCAP, &capability); r < 0) {
-    io_.close(fd);
+  if (const int r = io_.ioctl(fd.get(), VIDIOC_QUERYCAP, &capability); r < 0) {
     return halFail(deviceGone(r) ? HalErrc::kDisconnected : HalErrc::kNotSupported,
                    "the reopened device does not answer VIDIOC_QUERYCAP", -r);
   }
   if (capabilityProblem(capability) != nullptr) {
-    io_.close(fd);
     return halFail(HalErrc::kNotSupported, "the reopened device cannot stream video");
   }
-  fd_ = fd;
+  fd_ = std::move(fd);
   if (state_ == CameraState::kUnconfigured) {
     return {};
   }
@@ -500,14 +495,13 @@ void V4l2Camera::freeBuffers() {
     v4l2_requestbuffers request{};
     request.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     request.memory = V4L2_MEMORY_MMAP;
-    (void)io_.ioctl(fd_, VIDIOC_REQBUFS, &request);
+    (void)io_.ioctl(fd_.get(), VIDIOC_REQBUFS, &request);
   }
 }
 
 std::unexpected<hal::HalError> V4l2Camera::markLost(int err) {
-  if (fd_ >= 0) {
-    io_.close(fd_);
-    fd_ = -1;
+  if (fd_.valid()) {
+    fd_.reset();
     ++disconnects_;
   }
   if (state_ == CameraState::kStreaming) {

@@ -53,7 +53,7 @@ std::expected<std::unique_ptr<DiscoveryResponder>, std::string> DiscoveryRespond
   if (!address) {
     return Fail("discovery: " + address.error());
   }
-  UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  hal::UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!socket.valid()) {
     return Fail(detail::systemError("discovery: cannot create a UDP socket"));
   }
@@ -148,7 +148,7 @@ bool DiscoveryResponder::allowReply(std::uint32_t address, std::int64_t nowNs) {
 std::expected<std::vector<FoundDevice>, std::string> discoverDevices(
     const std::vector<std::string>& targets, std::uint16_t udpPort,
     std::chrono::milliseconds wait) {
-  const UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  const hal::UniqueFd socket(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!socket.valid()) {
     return Fail(detail::systemError("cannot create a UDP socket"));
   }

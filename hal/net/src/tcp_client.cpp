@@ -85,10 +85,11 @@ std::string toString(const DeviceAddress& address) {
 namespace {
 
 // One attempt on one resolved address; the socket when connected, else the reason.
-std::expected<UniqueFd, std::string> connectTo(const addrinfo& target, const std::string& where,
-                                               std::chrono::milliseconds timeout,
-                                               int receiveBufferBytes) {
-  UniqueFd fd(::socket(target.ai_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+std::expected<hal::UniqueFd, std::string> connectTo(const addrinfo& target,
+                                                    const std::string& where,
+                                                    std::chrono::milliseconds timeout,
+                                                    int receiveBufferBytes) {
+  hal::UniqueFd fd(::socket(target.ai_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd.valid()) {
     return std::unexpected(detail::systemError("cannot create a socket"));
   }

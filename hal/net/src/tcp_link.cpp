@@ -58,7 +58,7 @@ std::expected<std::unique_ptr<TcpLink>, std::string> TcpLink::create(
   const std::string where =
       (address.family() == AF_INET6 ? "[" + network.bindAddress + "]" : network.bindAddress) + ":" +
       std::to_string(network.port);
-  UniqueFd listener(::socket(address.family(), SOCK_STREAM | SOCK_CLOEXEC, 0));
+  hal::UniqueFd listener(::socket(address.family(), SOCK_STREAM | SOCK_CLOEXEC, 0));
   if (!listener.valid()) {
     return std::unexpected(detail::systemError("cannot create a socket"));
   }
@@ -102,7 +102,7 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
   }
   detail::SocketAddress peer;
   peer.length = sizeof peer.storage;
-  UniqueFd client(
+  hal::UniqueFd client(
       ::accept4(listener_.get(), peer.get(), &peer.length, SOCK_CLOEXEC | SOCK_NONBLOCK));
   if (!client.valid()) {
     if (detail::wouldBlock(errno) || errno == ECONNABORTED) {
@@ -125,7 +125,7 @@ hal::HalResult<void> TcpLink::acceptClient(std::int64_t timeoutNs) {
 void TcpLink::refusePending() {
   const std::int64_t now = detail::monotonicNs();
   while (true) {
-    UniqueFd extra(::accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
+    hal::UniqueFd extra(::accept4(listener_.get(), nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK));
     if (!extra.valid()) {
       return;
     }

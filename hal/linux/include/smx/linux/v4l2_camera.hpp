@@ -51,7 +51,7 @@ class V4l2Camera final : public hal::Camera {
   // kDisconnected while the device is still absent. A no-op while the device is present.
   [[nodiscard]] hal::HalResult<void> reopen();
   [[nodiscard]] hal::HalResult<void> recover() override { return reopen(); }
-  [[nodiscard]] bool lost() const { return fd_ < 0; }
+  [[nodiscard]] bool lost() const { return !fd_.valid(); }
 
   [[nodiscard]] std::string_view devicePath() const { return path_; }
   [[nodiscard]] int bufferCount() const { return static_cast<int>(buffers_.size()); }
@@ -70,8 +70,12 @@ class V4l2Camera final : public hal::Camera {
     std::uint64_t sequence = 0;  // of the frame borrowed from it
   };
 
-  V4l2Camera(std::string path, std::string id, int buffers, int fd, V4l2Io& io)
-      : path_(std::move(path)), id_(std::move(id)), wantedBuffers_(buffers), fd_(fd), io_(io) {}
+  V4l2Camera(std::string path, std::string id, int buffers, V4l2Fd fd, V4l2Io& io)
+      : path_(std::move(path)),
+        id_(std::move(id)),
+        wantedBuffers_(buffers),
+        fd_(std::move(fd)),
+        io_(io) {}
 
   [[nodiscard]] hal::HalResult<hal::CameraFormat> negotiate(const hal::CameraFormat& wanted);
   [[nodiscard]] hal::HalResult<void> startStreaming();
@@ -87,7 +91,7 @@ class V4l2Camera final : public hal::Camera {
   std::string path_;
   std::string id_;
   int wantedBuffers_;
-  int fd_;
+  V4l2Fd fd_;  // invalid while the device is lost
   V4l2Io& io_;
   hal::CameraState state_ = hal::CameraState::kUnconfigured;
   bool resumeStreaming_ = false;  // streaming when the device was lost

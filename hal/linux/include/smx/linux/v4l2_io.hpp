@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <expected>
 
+#include "smx/hal/unique_fd.hpp"
+
 // The system calls a V4L2 camera makes, behind an interface so that the camera's state machine
 // can be tested against a simulated driver (tests/hal_linux). Each call is wrapped once and
 // reports failure as -errno (libcamera's V4L2Device::ioctl); the caller adds context.
@@ -32,6 +34,15 @@ class V4l2Io {
  protected:
   V4l2Io() = default;
 };
+
+// Closes through the seam, so that a fake driver sees its descriptors closed.
+struct V4l2Close {
+  V4l2Io* io = nullptr;
+  void operator()(int fd) const { (void)io->close(fd); }
+};
+
+// A descriptor from V4l2Io::open, closed once by V4l2Io::close.
+using V4l2Fd = hal::BasicUniqueFd<V4l2Close>;
 
 // The real system calls. Stateless. open and ioctl retry EINTR; poll returns -EINTR, since only
 // the caller knows how much time is left.

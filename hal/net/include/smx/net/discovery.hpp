@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "smx/hal/error.hpp"
-#include "smx/net/unique_fd.hpp"
+#include "smx/hal/unique_fd.hpp"
 
 // Finding devices on the local network over UDP (docs/protocol.md "Discovery"). A host sends the
 // request "SMXP?" + version, zero-padded to kDiscoveryRequestBytes, to UDP port 5555, broadcast
@@ -54,12 +54,12 @@ class DiscoveryResponder {
     Window window;
   };
 
-  DiscoveryResponder(UniqueFd socket, std::uint16_t port)
+  DiscoveryResponder(hal::UniqueFd socket, std::uint16_t port)
       : socket_(std::move(socket)), port_(port) {}
   // Counts a reply to `address` now; false if a limit is reached.
   bool allowReply(std::uint32_t address, std::int64_t nowNs);
 
-  UniqueFd socket_;
+  hal::UniqueFd socket_;
   std::uint16_t port_;
   std::vector<std::byte> answer_;
   std::uint64_t ignored_ = 0;

@@ -7,7 +7,7 @@
 #include <span>
 #include <string>
 
-#include "smx/net/unique_fd.hpp"
+#include "smx/hal/unique_fd.hpp"
 
 // The host end of the link: a TCP connection to a device. Host tool code: errors are messages
 // that name the device and the system's reason.
@@ -42,8 +42,8 @@ class TcpClient {
   void close() { fd_.reset(); }
 
  private:
-  explicit TcpClient(UniqueFd fd) : fd_(std::move(fd)) {}
-  UniqueFd fd_;
+  explicit TcpClient(hal::UniqueFd fd) : fd_(std::move(fd)) {}
+  hal::UniqueFd fd_;
 };
 
 }  // namespace smx::net

@@ -8,7 +8,7 @@
 
 #include "smx/hal/board_config.hpp"
 #include "smx/hal/link.hpp"
-#include "smx/net/unique_fd.hpp"
+#include "smx/hal/unique_fd.hpp"
 
 // hal::Link over TCP, IPv4 or IPv6 (docs/protocol.md "Connections"): listens on the board's
 // address and port and serves one host, with TCP keepalive. A second host that connects while
@@ -40,17 +40,17 @@ class TcpLink final : public hal::Link {
   // closed when the host closes or after kRefusedLingerNs, so that a request the host sent
   // meanwhile does not make the kernel reset the connection before the host read the error.
   struct Refused {
-    UniqueFd fd;
+    hal::UniqueFd fd;
     std::int64_t closeAtNs = 0;
   };
 
-  TcpLink(UniqueFd listener, std::uint16_t port, int sendBufferBytes)
+  TcpLink(hal::UniqueFd listener, std::uint16_t port, int sendBufferBytes)
       : listener_(std::move(listener)), port_(port), sendBufferBytes_(sendBufferBytes) {}
   void refusePending();
   void closeRefused(std::int64_t nowNs);
 
-  UniqueFd listener_;
-  UniqueFd client_;
+  hal::UniqueFd listener_;
+  hal::UniqueFd client_;
   std::uint16_t port_;
   int sendBufferBytes_;
   std::uint64_t refused_ = 0;
