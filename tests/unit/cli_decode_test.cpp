@@ -11,6 +11,7 @@
 #include "cli.hpp"
 #include "cli_harness.hpp"
 #include "png_claim.hpp"
+#include "smx/sim/mesh_io.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"

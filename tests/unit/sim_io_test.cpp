@@ -12,6 +12,7 @@
 
 #include "alloc_counter.hpp"
 #include "png_claim.hpp"
+#include "smx/sim/mesh_io.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/ply_io.hpp"
 #include "smx/sim/png_io.hpp"
@@ -327,6 +328,71 @@ TEST(SimIo, PlyReaderAcceptsAsciiAndRejectsTruncatedOrForeignFiles) {
   for (const auto& p : {ascii, cut, huge, mesh}) {
     fs::remove(p);
   }
+}
+
+// Point clouds go through the mesh reader: its encodings, its checks and its messages.
+TEST(SimIo, PlyPointsAreReadByTheMeshReaderWithColourAndItsChecks) {
+  const auto write = [](const std::string& name, const std::string& bytes) {
+    const auto path = tempFile(name);
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  };
+  const std::string colourHeader =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "end_header\n";
+  // Given ascii with colour, then big-endian binary (which the old point reader refused)
+  const auto colour = write("colour.ply", colourHeader + "1 2 3 10 20 30\n4 5 6 255 0 1\n");
+  const auto c = readPlyPoints(colour);
+  ASSERT_TRUE(c.has_value()) << c.error();
+  ASSERT_EQ(c->size(), 2U);
+  EXPECT_EQ((*c)[1].x, 4.0F);
+  EXPECT_EQ((*c)[0].g, 20);
+  EXPECT_EQ((*c)[1].r, 255);
+  std::string big =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  for (const std::uint32_t bits : {0x3F800000U, 0x40000000U, 0xC0400000U}) {  // 1, 2, -3
+    for (int shift = 24; shift >= 0; shift -= 8) {
+      big += static_cast<char>((bits >> static_cast<unsigned>(shift)) & 0xFFU);
+    }
+  }
+  const auto bigEndian = write("big.ply", big);
+  const auto b = readPlyPoints(bigEndian);
+  ASSERT_TRUE(b.has_value()) << b.error();
+  ASSERT_EQ(b->size(), 1U);
+  EXPECT_EQ((*b)[0].z, -3.0F);
+  EXPECT_EQ((*b)[0].r, 0);
+
+  // Then hostile values are refused with the file, the line and the problem
+  const auto expectRefused = [&](const std::string& name, const std::string& bytes,
+                                 const std::string& part) {
+    const auto path = write(name, bytes);
+    const auto r = readPlyPoints(path);
+    ASSERT_FALSE(r.has_value()) << name;
+    EXPECT_NE(r.error().find(path.string() + ": "), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find(part), std::string::npos) << r.error();
+    fs::remove(path);
+  };
+  expectRefused("nan.ply", colourHeader + "1 2 3 0 0 0\nnan 5 6 0 0 0\n",
+                "line 12: vertex 1: x is not a finite number");
+  expectRefused("inf.ply", colourHeader + "1 2 inf 0 0 0\n4 5 6 0 0 0\n",
+                "z is not a finite number");
+  expectRefused("red.ply", colourHeader + "1 2 3 256 0 0\n4 5 6 0 0 0\n",
+                "colour \"red\" = 256 is not an integer 0..255");
+  expectRefused("short.ply", colourHeader + "1 2 3 0 0 0\n",
+                "the file ends before vertex 1 of the 2");
+  // A count below the 32-bit limit but far beyond the file: refused, not allocated.
+  expectRefused("count.ply",
+                "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+                "property float x\nproperty float y\nproperty float z\nend_header\n",
+                "the file ends before property \"x\"");
+  expectRefused("count64.ply",
+                "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\n"
+                "property float y\nproperty float z\nend_header\n",
+                "at most 4294967295 are supported");
+  fs::remove(colour);
+  fs::remove(bigEndian);
 }
 
 }  // namespace

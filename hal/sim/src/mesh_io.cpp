@@ -249,14 +249,18 @@ struct PlyHeader {
   std::size_t dataOffset = 0;  // byte offset of `data` in the file (binary)
 };
 
-// What the reader takes from the elements: positions and the faces' vertex lists.
+// What the reader takes from the elements: positions, colours (point clouds) and the faces'
+// vertex lists (meshes).
 struct PlyLayout {
-  std::size_t vertex = 0;   // element index
-  std::vector<int> axisOf;  // per vertex property: 0, 1, 2 for x, y, z, else -1
-  std::size_t face = 0;     // element index
-  std::size_t indices = 0;  // property index of vertex_indices in the face element
+  std::size_t vertex = 0;           // element index
+  std::vector<int> axisOf;          // per vertex property: 0, 1, 2 for x, y, z, else -1
+  std::vector<int> colourOf;        // per vertex property: 0, 1, 2 for red, green, blue, else -1
+  std::optional<std::size_t> face;  // element index; none for point clouds
+  std::size_t indices = 0;          // property index of vertex_indices in the face element
   std::uint64_t vertexCount = 0;
 };
+
+enum class PlyUse : std::uint8_t { kMesh, kPoints };
 
 constexpr std::string_view kPlyTypesHint =
     "PLY types: char, uchar, short, ushort, int, uint, float, double (or int8, uint8, int16, "
@@ -408,7 +412,7 @@ std::expected<PlyHeader, std::string> readPlyHeader(std::string_view bytes) {
               std::to_string(lines.number()) + ")");
 }
 
-std::expected<PlyLayout, std::string> plyLayout(const PlyHeader& header) {
+std::expected<PlyLayout, std::string> plyLayout(const PlyHeader& header, PlyUse use) {
   PlyLayout layout;
   const auto find = [&](std::string_view name) {
     return std::find_if(header.elements.begin(), header.elements.end(),
@@ -440,7 +444,24 @@ std::expected<PlyLayout, std::string> plyLayout(const PlyHeader& header) {
     }
     layout.axisOf[static_cast<std::size_t>(it - vertex->properties.begin())] = axis;
   }
+  layout.colourOf.assign(vertex->properties.size(), -1);
   const auto face = find("face");
+  if (use == PlyUse::kPoints) {
+    for (std::size_t p = 0; p < vertex->properties.size(); ++p) {
+      const auto& name = vertex->properties[p].name;
+      const int channel = name == "red" ? 0 : name == "green" ? 1 : name == "blue" ? 2 : -1;
+      if (channel >= 0 && vertex->properties[p].countType) {
+        return fail("element \"vertex\" (line " + std::to_string(vertex->line) + "): property " +
+                    shown(name) + " must be a single number, not a list");
+      }
+      layout.colourOf[p] = channel;
+    }
+    if (face != header.elements.end()) {
+      return fail("element \"face\" (line " + std::to_string(face->line) +
+                  "): a point cloud has no faces; this is a mesh");
+    }
+    return layout;
+  }
   if (face == header.elements.end()) {
     return fail(
         "the header declares no \"face\" element: a point cloud has no triangles to render");
@@ -455,6 +476,14 @@ std::expected<PlyLayout, std::string> plyLayout(const PlyHeader& header) {
   }
   layout.indices = static_cast<std::size_t>(indices - face->properties.begin());
   return layout;
+}
+
+// A colour channel as PLY stores it (uchar): 0..255, whatever the declared type.
+std::optional<std::uint8_t> channelValue(double v) {
+  if (!(v >= 0 && v <= 255 && v == std::floor(v))) {
+    return std::nullopt;
+  }
+  return static_cast<std::uint8_t>(v);
 }
 
 // The least number of bytes one row can take: bounds reservations by what the file can hold.
@@ -639,17 +668,22 @@ std::string vertexCountText(std::uint64_t count) {
                     : std::to_string(count) + " vertices (0 to " + std::to_string(count - 1) + ")";
 }
 
+// Fills mesh.vertices and mesh.triangles, and with `colours` a colour per vertex.
 template <class Source>
-Status readPlyData(Source& source, const PlyHeader& header, const PlyLayout& layout, Mesh& mesh) {
+Status readPlyData(Source& source, const PlyHeader& header, const PlyLayout& layout, Mesh& mesh,
+                   std::vector<std::array<std::uint8_t, 3>>* colours) {
   std::vector<std::uint32_t> polygon;
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     const PlyElement& element = header.elements[e];
     const bool isVertex = e == layout.vertex;
-    const bool isFace = e == layout.face;
+    const bool isFace = layout.face && e == *layout.face;
     const std::size_t maxRows = header.data.size() / minRowBytes(element, header.encoding);
     const auto reserve = static_cast<std::size_t>(std::min<std::uint64_t>(element.count, maxRows));
     if (isVertex) {
       mesh.vertices.reserve(reserve);
+      if (colours != nullptr) {
+        colours->reserve(reserve);
+      }
     } else if (isFace) {
       mesh.triangles.reserve(reserve);
     }
@@ -659,6 +693,7 @@ Status readPlyData(Source& source, const PlyHeader& header, const PlyLayout& lay
         return fail(source.endedBefore(rowName(), element));
       }
       std::array<double, 3> xyz{};
+      std::array<std::uint8_t, 3> rgb{};
       for (std::size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& property = element.properties[p];
         double value = 0;
@@ -668,6 +703,14 @@ Status readPlyData(Source& source, const PlyHeader& header, const PlyLayout& lay
           }
           if (isVertex && layout.axisOf[p] >= 0) {
             xyz[static_cast<std::size_t>(layout.axisOf[p])] = value;
+          }
+          if (isVertex && colours != nullptr && layout.colourOf[p] >= 0) {
+            const auto channel = channelValue(value);
+            if (!channel) {
+              return fail(source.at(rowName()) + ": colour " + shown(property.name) + " = " +
+                          formatValue(value) + " is not an integer 0..255");
+            }
+            rgb[static_cast<std::size_t>(layout.colourOf[p])] = *channel;
           }
           continue;
         }
@@ -714,32 +757,39 @@ Status readPlyData(Source& source, const PlyHeader& header, const PlyLayout& lay
           return fail(source.at(rowName()) + ": " + *problem);
         }
         mesh.vertices.push_back(toVertex(xyz));
+        if (colours != nullptr) {
+          colours->push_back(rgb);
+        }
       }
     }
   }
   return source.finish();
 }
 
-std::expected<Mesh, std::string> parsePly(std::string_view bytes) {
+// The one PLY reader: meshes (kMesh: faces required, colour ignored) and point clouds (kPoints:
+// no faces, colour read into `colours`).
+Status parsePlyInto(std::string_view bytes, PlyUse use, Mesh& mesh,
+                    std::vector<std::array<std::uint8_t, 3>>* colours) {
   const auto header = readPlyHeader(bytes);
   if (!header) {
     return std::unexpected(header.error());
   }
-  const auto layout = plyLayout(*header);
+  const auto layout = plyLayout(*header, use);
   if (!layout) {
     return std::unexpected(layout.error());
   }
-  Mesh mesh;
-  Status read;
   if (header->encoding == PlyEncoding::kAscii) {
     AsciiSource source(header->data, header->dataLine);
-    read = readPlyData(source, *header, *layout, mesh);
-  } else {
-    BinarySource source(header->data, header->dataOffset,
-                        header->encoding == PlyEncoding::kBigEndian);
-    read = readPlyData(source, *header, *layout, mesh);
+    return readPlyData(source, *header, *layout, mesh, colours);
   }
-  if (!read) {
+  BinarySource source(header->data, header->dataOffset,
+                      header->encoding == PlyEncoding::kBigEndian);
+  return readPlyData(source, *header, *layout, mesh, colours);
+}
+
+std::expected<Mesh, std::string> parsePly(std::string_view bytes) {
+  Mesh mesh;
+  if (auto read = parsePlyInto(bytes, PlyUse::kMesh, mesh, nullptr); !read) {
     return std::unexpected(read.error());
   }
   if (mesh.triangles.empty()) {
@@ -879,7 +929,7 @@ std::expected<std::string, std::string> readFile(const std::filesystem::path& pa
     return fail("cannot read the file: " + ec.message());
   }
   if (size > kMaxMeshBytes) {
-    return fail("the file is " + std::to_string(size) + " bytes; meshes of at most " +
+    return fail("the file is " + std::to_string(size) + " bytes; files of at most " +
                 std::to_string(kMaxMeshBytes) + " bytes are read");
   }
   std::ifstream in(path, std::ios::binary);
@@ -946,6 +996,31 @@ std::expected<Mesh, MeshError> loadMesh(const std::filesystem::path& path) {
     return mesh;
   } catch (const std::exception& e) {
     return withFile(std::string("cannot read the mesh: ") + e.what());
+  }
+}
+
+std::expected<std::vector<PlyPoint>, std::string> readPlyPoints(const std::filesystem::path& path) {
+  const auto withFile = [&](const std::string& problem) {
+    return std::unexpected(path.string() + ": " + problem);
+  };
+  try {
+    const auto bytes = readFile(path);
+    if (!bytes) {
+      return withFile(bytes.error());
+    }
+    Mesh cloud;
+    std::vector<std::array<std::uint8_t, 3>> colours;
+    if (auto read = parsePlyInto(*bytes, PlyUse::kPoints, cloud, &colours); !read) {
+      return withFile(read.error());
+    }
+    std::vector<PlyPoint> points(cloud.vertices.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3f& v = cloud.vertices[i];
+      points[i] = {v.x(), v.y(), v.z(), colours[i][0], colours[i][1], colours[i][2]};
+    }
+    return points;
+  } catch (const std::exception& e) {
+    return withFile(std::string("cannot read the point cloud: ") + e.what());
   }
 }
 
