@@ -480,7 +480,7 @@ std::expected<PlyLayout, std::string> plyLayout(const PlyHeader& header, PlyUse 
 
 // A colour channel as PLY stores it (uchar): 0..255, whatever the declared type.
 std::optional<std::uint8_t> channelValue(double v) {
-  if (!(v >= 0 && v <= 255 && v == std::floor(v))) {
+  if (v < 0 || v > 255 || v != std::floor(v)) {  // NaN too: NaN != NaN
     return std::nullopt;
   }
   return static_cast<std::uint8_t>(v);
