@@ -22,7 +22,6 @@
 #include <cstdint>
 
 #include "demux_kernels.hpp"
-#include "smx/algo/fixed.hpp"
 
 namespace smx::algo::demux {
 
