@@ -15,7 +15,7 @@ namespace demux {
 
 void UnitTable::fill() {
   for (std::size_t i = 0; i < kEntries; ++i) {
-    cos_[i] = algo::cos(BinAngle{static_cast<std::uint16_t>(i * (65536 / kEntries))}).raw();
+    cos_[i] = algo::cos(BinAngle{static_cast<std::uint16_t>(i * (65536 / kEntries))});
   }
 }
 

@@ -116,8 +116,8 @@ Boundary boundaryAt(const ConstRgbView& image, int x, int y, std::uint16_t direc
     return {};
   }
   const BinAngle angle{direction};
-  const std::int32_t dx = (std::int32_t{algo::cos(angle).raw()} + 32) >> 6;  // Q1.14 → Q8
-  const std::int32_t dy = (std::int32_t{algo::sin(angle).raw()} + 32) >> 6;
+  const std::int32_t dx = (std::int32_t{algo::cos(angle)} + 32) >> 6;  // Q1.14 → Q8
+  const std::int32_t dy = (std::int32_t{algo::sin(angle)} + 32) >> 6;
   const std::int32_t xq = x * kOne;
   const std::int32_t yq = y * kOne;
   const auto ia = static_cast<std::size_t>(a.colour);

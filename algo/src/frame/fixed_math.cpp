@@ -67,8 +67,7 @@ constexpr auto kSinQ30 = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(nearest(sinSeries(x) * 0x1p30));
   }
   return t;
-}
-();
+}();
 static_assert(kSinQ30[0] == 0 && kSinQ30[kSinIntervals] == (1 << 30));
 
 // atan(i / 256) for i in [0, 256] in units of 2^-32 turn (π/4 = 2^29), plus one padding entry
@@ -82,8 +81,7 @@ constexpr auto kAtanTurn32 = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(nearest(turns * 0x1p32));
   }
   return t;
-}
-();
+}();
 static_assert(kAtanTurn32[0] == 0 && kAtanTurn32[kAtanIntervals] == (1U << 29));
 
 // Seed for 2^63 / d, d in [2^31, 2^32), indexed by the 8 bits below the leading one:
@@ -94,8 +92,7 @@ constexpr auto kRecipSeed = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::uint16_t>(nearest(0x1p24 / (256.5 + i)));
   }
   return t;
-}
-();
+}();
 
 // Seed for √m · 2^16, m = xn / 2^(bits) in [1/4, 1), indexed by the top 8 bits (64..255):
 // the root at the bucket midpoint.
@@ -106,8 +103,7 @@ constexpr auto kSqrtSeed = [] consteval {
         static_cast<std::uint16_t>(nearest(sqrtNewton((i + 0.5) / 256.0) * 0x1p16));
   }
   return t;
-}
-();
+}();
 
 // ---- Kernels -------------------------------------------------------------------------------
 
@@ -162,7 +158,7 @@ BinAngle atan2Magnitudes(std::uint64_t ax, std::uint64_t ay, bool xNegative, boo
 
 }  // namespace
 
-Q<1, 14> sin(BinAngle angle) noexcept {
+std::int16_t sin(BinAngle angle) noexcept {
   const std::uint32_t raw = angle.raw;
   const std::uint32_t quadrant = raw >> 14;
   std::uint32_t p = raw & 0x3FFFU;
@@ -171,10 +167,10 @@ Q<1, 14> sin(BinAngle angle) noexcept {
   }
   const std::int32_t magnitudeQ14 = quarterSin(p);
   const std::int32_t value = (quadrant & 2U) != 0 ? -magnitudeQ14 : magnitudeQ14;
-  return Q<1, 14>::fromRaw(static_cast<std::int16_t>(value));
+  return static_cast<std::int16_t>(value);
 }
 
-Q<1, 14> cos(BinAngle angle) noexcept {
+std::int16_t cos(BinAngle angle) noexcept {
   return sin(angle + BinAngle{BinAngle::kQuarterTurn});
 }
 
