@@ -2,7 +2,9 @@
 // reference (src/frame/demux/reference) and the schedule run() calls (src/frame/demux/schedule;
 // on x86-64 a baseline and an AVX2 build of it). Given the same inputs, every built schedule
 // must give the reference's output bit for bit. The inputs of each stage are the reference
-// outputs of the stages before it, on noisy rendered frames of 1, 2 and 3 superposed patterns.
+// outputs of the stages before it, on noisy frames of 1, 2 and 3 superposed patterns computed
+// here (on every target) and, in the host's optimised build, on the simulator's renders of the
+// sphere (2 projectors) and the plane (3 projectors) at 640 × 480.
 #include "demux_reference.hpp"
 
 #include <gtest/gtest.h>
@@ -18,6 +20,11 @@
 #include "smx/algo/demux.hpp"
 #include "smx/algo/fixed_math.hpp"
 #include "synthetic_stripes.hpp"
+
+#if SMX_REFERENCE_SIM_SCENES
+#include "smx/algo/encoding_prediction.hpp"
+#include "smx/eval/sim_frame.hpp"
+#endif
 
 namespace smx::algo {
 namespace {
@@ -113,6 +120,24 @@ Frame makeFrame(std::string name, const std::vector<SyntheticPattern>& patterns,
   return f;
 }
 
+#if SMX_REFERENCE_SIM_SCENES
+// Camera 0 of an example rig viewing a named scene, predictions at the accuracy tests' nominal
+// depth (0.75 m, the scenes stand at 0.9 m).
+Frame renderedFrame(std::string name, const std::string& rigFile, const std::string& scene) {
+  eval::SimRequest request;
+  request.rigFile = rigFile;
+  request.scene = scene;
+  request.supersampling = 1;  // one sample per pixel: the stages see the same kind of image, sooner
+  const eval::SimFrame sim = eval::renderSimFrame(request);
+  Frame f{std::move(name),
+          {sim.image.width, sim.image.height, static_cast<int>(sim.rig.projectors.size()), {}},
+          sim.image.pixels,
+          {}};
+  f.predicted = *predictEncodingAngles(sim.rig, 0, f.layout, 0.75);
+  return f;
+}
+#endif
+
 const std::vector<Frame>& frames() {
   static const std::vector<Frame> kFrames = [] {
     DemuxParams other;  // the other code paths: tiles of 6, every pixel sampled, 2 passes
@@ -126,6 +151,10 @@ const std::vector<Frame>& frames() {
     f.push_back(makeFrame("2Patterns", {{0, 4.5}, {70, 4.5}}, 211, 97, {}, true));
     f.push_back(makeFrame("3Patterns", {{0, 5.0}, {60, 5.0}, {120, 5.0}}, 211, 97, {}, false));
     f.push_back(makeFrame("2PatternsOtherParams", {{20, 5.0}, {100, 5.0}}, 149, 83, other, true));
+#if SMX_REFERENCE_SIM_SCENES
+    f.push_back(renderedFrame("SphereRig2Proj", "rig_2proj_1cam.json", "sphere"));
+    f.push_back(renderedFrame("PlaneRig3Proj", "rig_3proj_1cam.json", "plane"));
+#endif
     return f;
   }();
   return kFrames;

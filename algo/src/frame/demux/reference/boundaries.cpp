@@ -143,7 +143,7 @@ void boundaries(const Planes3& separated, ImageView<const std::uint8_t> order,
     const std::size_t tile =
         static_cast<std::size_t>(y / t) * static_cast<std::size_t>(layout.tilesX()) +
         static_cast<std::size_t>(x / t);
-    const std::int32_t scale =
+    const auto scale =
         static_cast<std::int32_t>((inverse[tile * 3 + static_cast<std::size_t>(c)] + 8) >> 4);
     const std::int32_t largest = (32767 << kProductShift) / scale;
     return Divisor{scale, std::min(largest, 32767)};

@@ -11,7 +11,8 @@ namespace smx::algo::demux::reference {
 
 namespace {
 
-// 2 × ∂S along x and y at (x, y): Σ_{i,j} kD1_i kPre_j S(x + i, y + j) >> 15 and the transpose.
+// 2 × ∂S along x and y at (x, y): Σ_{i,j} kD1_i kPre_j S(x + i − 2, y + j − 2) >> 15 and the
+// transpose.
 // |sum| <= 256 · 256 · 4080 < 2^31.
 struct Gradient {
   std::int32_t x;
@@ -21,11 +22,11 @@ struct Gradient {
 Gradient gradientAt(ImageView<const std::int16_t> s, int x, int y) {
   std::int32_t sumX = 0;
   std::int32_t sumY = 0;
-  for (int j = -2; j <= 2; ++j) {
-    for (int i = -2; i <= 2; ++i) {
-      const std::int32_t v = s(x + i, y + j);
-      sumX += kD1[static_cast<std::size_t>(i + 2)] * kPre[static_cast<std::size_t>(j + 2)] * v;
-      sumY += kPre[static_cast<std::size_t>(i + 2)] * kD1[static_cast<std::size_t>(j + 2)] * v;
+  for (std::size_t j = 0; j < 5; ++j) {
+    for (std::size_t i = 0; i < 5; ++i) {
+      const std::int32_t v = s(x + static_cast<int>(i) - 2, y + static_cast<int>(j) - 2);
+      sumX += kD1[i] * kPre[j] * v;
+      sumY += kPre[i] * kD1[j] * v;
     }
   }
   return {sumX >> kDerivShift, sumY >> kDerivShift};

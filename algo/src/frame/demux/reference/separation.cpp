@@ -12,7 +12,7 @@ namespace smx::algo::demux::reference {
 
 namespace {
 
-// 2^-13 of the separable filter sums Σ_{i,j} h_i v_j S(x + i, y + j) (i along x), which fit
+// 2^-13 of the separable filter sums Σ_{i,j} h_i v_j S(x + i − 2, y + j − 2) (i along x), which fit
 // int16 (|·| <= 16 575 for 0 <= S <= 4080).
 constexpr int kKeepShift = 13;
 
@@ -20,10 +20,10 @@ std::int32_t filtered(ImageView<const std::int16_t> s, int x, int y,
                       const std::array<std::int32_t, 5>& horizontal,
                       const std::array<std::int32_t, 5>& vertical) {
   std::int32_t sum = 0;
-  for (int j = -2; j <= 2; ++j) {
-    for (int i = -2; i <= 2; ++i) {
-      sum += horizontal[static_cast<std::size_t>(i + 2)] *
-             vertical[static_cast<std::size_t>(j + 2)] * s(x + i, y + j);
+  for (std::size_t j = 0; j < 5; ++j) {
+    for (std::size_t i = 0; i < 5; ++i) {
+      sum +=
+          horizontal[i] * vertical[j] * s(x + static_cast<int>(i) - 2, y + static_cast<int>(j) - 2);
     }
   }
   return sum >> kKeepShift;
