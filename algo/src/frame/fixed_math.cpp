@@ -67,7 +67,8 @@ constexpr auto kSinQ30 = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(nearest(sinSeries(x) * 0x1p30));
   }
   return t;
-}();
+}
+();
 static_assert(kSinQ30[0] == 0 && kSinQ30[kSinIntervals] == (1 << 30));
 
 // atan(i / 256) for i in [0, 256] in units of 2^-32 turn (π/4 = 2^29), plus one padding entry
@@ -81,7 +82,8 @@ constexpr auto kAtanTurn32 = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(nearest(turns * 0x1p32));
   }
   return t;
-}();
+}
+();
 static_assert(kAtanTurn32[0] == 0 && kAtanTurn32[kAtanIntervals] == (1U << 29));
 
 // Seed for 2^63 / d, d in [2^31, 2^32), indexed by the 8 bits below the leading one:
@@ -92,7 +94,8 @@ constexpr auto kRecipSeed = [] consteval {
     t[static_cast<std::size_t>(i)] = static_cast<std::uint16_t>(nearest(0x1p24 / (256.5 + i)));
   }
   return t;
-}();
+}
+();
 
 // Seed for √m · 2^16, m = xn / 2^(bits) in [1/4, 1), indexed by the top 8 bits (64..255):
 // the root at the bucket midpoint.
@@ -103,7 +106,8 @@ constexpr auto kSqrtSeed = [] consteval {
         static_cast<std::uint16_t>(nearest(sqrtNewton((i + 0.5) / 256.0) * 0x1p16));
   }
   return t;
-}();
+}
+();
 
 // ---- Kernels -------------------------------------------------------------------------------
 
