@@ -14,7 +14,7 @@
 //                      with the kernels' AVX2 build where the CPU has it (context
 //                      demux_kernels), as OpenCV dispatches its Sobel;
 //   <cfg>/demux_baseline
-//                      the same with DemuxParams::avx2 off: the SSE2 build, what an x86-64
+//                      the same with DemuxSchedule::kBaseline: the SSE2 build, what an x86-64
 //                      without AVX2 runs (checked equal to <cfg>/demux's output first);
 //   <cfg>/1_smooth … <cfg>/8_boundaries
 //                      each kernel of algo/src/frame/demux_kernels.hpp alone (the build
@@ -282,7 +282,7 @@ struct Config {
   std::vector<std::byte> memory;
   std::unique_ptr<algo::Arena> arena;
   std::unique_ptr<algo::Demultiplexer> demux;
-  std::vector<std::byte> baselineMemory;  // the same with DemuxParams::avx2 off
+  std::vector<std::byte> baselineMemory;  // the same with DemuxSchedule::kBaseline
   std::unique_ptr<algo::Arena> baselineArena;
   std::unique_ptr<algo::Demultiplexer> baseline;
   std::unique_ptr<Stages> stages;
@@ -367,11 +367,10 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int 
     die(c->name + ": create: " + demux.error().message);
   }
   c->demux = std::make_unique<algo::Demultiplexer>(std::move(*demux));
-  algo::DemuxLayout baselineLayout = c->layout;
-  baselineLayout.params.avx2 = false;
   c->baselineMemory.resize(*bytes);
   c->baselineArena = std::make_unique<algo::Arena>(c->baselineMemory);
-  auto baseline = algo::Demultiplexer::create(baselineLayout, *predicted, *c->baselineArena);
+  auto baseline = algo::Demultiplexer::create(c->layout, *predicted, *c->baselineArena,
+                                              algo::DemuxSchedule::kBaseline);
   if (!baseline) {
     die(c->name + ": create (baseline): " + baseline.error().message);
   }

@@ -26,16 +26,12 @@ struct OwnedDemux {
   Arena arena;
   Demultiplexer demux;
 
-  OwnedDemux(const DemuxLayout& layout, const std::vector<std::uint16_t>& predicted)
+  OwnedDemux(const DemuxLayout& layout, const std::vector<std::uint16_t>& predicted,
+             DemuxSchedule schedule)
       : memory(*Demultiplexer::workspaceBytes(layout)),
         arena(memory),
-        demux(*Demultiplexer::create(layout, predicted, arena)) {}
+        demux(*Demultiplexer::create(layout, predicted, arena, schedule)) {}
 };
-
-DemuxLayout withAvx2(DemuxLayout layout, bool avx2) {
-  layout.params.avx2 = avx2;
-  return layout;
-}
 
 template <class T>
 bool sameRows(ImageView<const T> a, ImageView<const T> b) {
@@ -92,8 +88,8 @@ TEST_P(DemuxKernels, TheAvx2BuildGivesTheBaselineOutput) {
   }
   const auto image = noisyFrame(patterns, kW, kH);
   const auto view = *ConstRgbView::packed(image, kW, kH);
-  OwnedDemux fast(withAvx2(layout, true), predicted);
-  OwnedDemux baseline(withAvx2(layout, false), predicted);
+  OwnedDemux fast(layout, predicted, DemuxSchedule::kAutomatic);
+  OwnedDemux baseline(layout, predicted, DemuxSchedule::kBaseline);
   ASSERT_TRUE(fast.demux.run(view).has_value());
   ASSERT_TRUE(baseline.demux.run(view).has_value());
 

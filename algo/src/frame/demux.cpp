@@ -15,7 +15,7 @@ namespace demux {
 
 void UnitTable::fill() {
   for (std::size_t i = 0; i < kEntries; ++i) {
-    cos_[i] = algo::cos(BinAngle{static_cast<std::uint16_t>(i * (65536 / kEntries))}).raw();
+    cos_[i] = algo::cos(BinAngle{static_cast<std::uint16_t>(i * (65536 / kEntries))});
   }
 }
 
@@ -130,7 +130,7 @@ Result<std::size_t> Demultiplexer::workspaceBytes(const DemuxLayout& layout) {
 
 Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
                                             std::span<const std::uint16_t> predictedAngles,
-                                            Arena& arena) {
+                                            Arena& arena, DemuxSchedule schedule) {
   if (auto ok = validate(layout); !ok) {
     return std::unexpected(ok.error());
   }
@@ -147,7 +147,8 @@ Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
   for (std::size_t i = 0; i < predictedAngles.size(); ++i) {
     d.predicted_[i] = predictedAngles[i];
   }
-  d.kernels_ = layout.params.avx2 ? &demux::fastestKernels() : &demux::baselineKernels();
+  d.kernels_ =
+      schedule == DemuxSchedule::kAutomatic ? &demux::fastestKernels() : &demux::baselineKernels();
   d.units_[0].fill();
   demux::tileInterpolation(layout.width, layout.params.tilePx, layout.tilesX(), d.columns_);
   demux::tileInterpolation(layout.height, layout.params.tilePx, layout.tilesY(), d.rows_);

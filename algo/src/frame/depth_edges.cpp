@@ -1,4 +1,5 @@
-// The depth-edge filter (depth_edges.hpp).
+// The depth-edge filter (depth_edges.hpp; not in the paper: it removes depths across jumps).
+// This scalar code is the reference; no separate schedule exists.
 #include "smx/algo/depth_edges.hpp"
 
 #include <cstdint>

@@ -1,5 +1,7 @@
-// Direct colour estimation (the baseline of docs/demux.md): per-pixel hue classes and the
-// boundaries between them along a given direction.
+// Direct colour estimation (the baseline of docs/demux.md; paper §2, which argues that the
+// colours of superposed patterns cannot be read directly): per-pixel hue classes and the
+// boundaries between them along a given direction. This scalar code is the reference; no
+// separate schedule exists.
 //   Input    Rgb8 image (grey levels), direction plane (BinAngle raw).
 //   Colours  int32 Q8 grey levels (value · 256): a pixel exactly, a sample between pixels by
 //            bilinear weights in 1/256 pixel, rounded half up. At most 255 · 256 = 65 280.
@@ -116,8 +118,8 @@ Boundary boundaryAt(const ConstRgbView& image, int x, int y, std::uint16_t direc
     return {};
   }
   const BinAngle angle{direction};
-  const std::int32_t dx = (std::int32_t{algo::cos(angle).raw()} + 32) >> 6;  // Q1.14 → Q8
-  const std::int32_t dy = (std::int32_t{algo::sin(angle).raw()} + 32) >> 6;
+  const std::int32_t dx = (std::int32_t{algo::cos(angle)} + 32) >> 6;  // Q1.14 → Q8
+  const std::int32_t dy = (std::int32_t{algo::sin(angle)} + 32) >> 6;
   const std::int32_t xq = x * kOne;
   const std::int32_t yq = y * kOne;
   const auto ia = static_cast<std::size_t>(a.colour);

@@ -162,7 +162,7 @@ BinAngle atan2Magnitudes(std::uint64_t ax, std::uint64_t ay, bool xNegative, boo
 
 }  // namespace
 
-Q<1, 14> sin(BinAngle angle) noexcept {
+std::int16_t sin(BinAngle angle) noexcept {
   const std::uint32_t raw = angle.raw;
   const std::uint32_t quadrant = raw >> 14;
   std::uint32_t p = raw & 0x3FFFU;
@@ -171,10 +171,10 @@ Q<1, 14> sin(BinAngle angle) noexcept {
   }
   const std::int32_t magnitudeQ14 = quarterSin(p);
   const std::int32_t value = (quadrant & 2U) != 0 ? -magnitudeQ14 : magnitudeQ14;
-  return Q<1, 14>::fromRaw(static_cast<std::int16_t>(value));
+  return static_cast<std::int16_t>(value);
 }
 
-Q<1, 14> cos(BinAngle angle) noexcept {
+std::int16_t cos(BinAngle angle) noexcept {
   return sin(angle + BinAngle{BinAngle::kQuarterTurn});
 }
 

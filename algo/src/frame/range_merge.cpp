@@ -1,4 +1,6 @@
-// The median-variant merge (range_merge.hpp).
+// The median-variant merge (range_merge.hpp; paper §4.2, "data merging stage": the ranges of
+// the separated patterns merged per image). This scalar code is the reference; no separate
+// schedule exists.
 #include "smx/algo/range_merge.hpp"
 
 #include <array>

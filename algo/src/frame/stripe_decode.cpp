@@ -1,4 +1,6 @@
-// Multi-layer decoding (stripe_decode.hpp). Numerics:
+// Multi-layer decoding (stripe_decode.hpp; paper §4.1–4.2: the colour-stripe permutation code
+// matched along the separated boundaries, multi-layer decoding after its [31]). This scalar code
+// is the reference; no separate schedule exists. Numerics:
 //   Positions  Q8 pixels (int32); a boundary lies at its pixel centre + offset (Q8) along the
 //              encoding direction of that pixel, whose unit vector is Q1.14 (demux::UnitTable);
 //              the shift offset·u is rounded half up to Q8 once per frame (|shift| ≤ 128).

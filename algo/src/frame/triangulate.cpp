@@ -1,5 +1,6 @@
-// Triangulation per frame (triangulation.hpp): the tables copied into the arena at create(),
-// one integer division per pixel.
+// Triangulation per frame (triangulation.hpp; paper §4.2: range from the decoded stripe
+// coordinate and the calibration): the tables copied into the arena at create(), one integer
+// division per pixel. This scalar code is the reference; no separate schedule exists.
 #include <cstdint>
 
 #include "smx/algo/triangulation.hpp"

@@ -14,7 +14,8 @@
 // the same colour-stripe pattern of 1–3 projectors is superposed at different orientations,
 // each projector's stripe boundaries with their colour transitions.
 //
-// Stages, all per frame, integer-only and allocation-free (src/frame/demux_*.cpp):
+// Stages, all per frame, integer-only and allocation-free (src/frame/demux/schedule/*.cpp, each
+// with its plain scalar definition in src/frame/demux/reference/*.cpp):
 //   1. binomial smoothing of each channel (×16 fixed point);
 //   2. per tile, the magnitude-weighted histogram of doubled gradient angles over a window of
 //      tiles; its lobes, refined by a local weighted mean, are matched to each projector's
@@ -44,7 +45,14 @@ struct DemuxParams {
   int minContrastGrey = 4;       // and in grey levels per pixel (max − min over the channels)
   int smoothPasses = 1;          // step 1: 3×3 binomial passes (σ 0.7 px; two: σ 1 px)
   bool normaliseColour = true;   // step 4
-  bool avx2 = true;  // x86-64: the kernels' AVX2 build where the CPU has it (same output)
+};
+
+// Which build of the vectorised stages run() calls: a choice of schedule, not of algorithm, as
+// every build gives the same output bit for bit (DemuxReference.* compares each with the scalar
+// reference of src/frame/demux/reference).
+enum class DemuxSchedule : std::uint8_t {
+  kAutomatic,  // x86-64: the AVX2 build where the CPU has it; else the baseline
+  kBaseline,   // the baseline build (SSE2 on x86-64, NEON on aarch64)
 };
 
 // The frame geometry fixed at init: image size, projector count and each projector's predicted
@@ -82,9 +90,9 @@ class Demultiplexer {
 
   // predictedAngles: tileCount() × projectors values, tile-major (tile t, projector p at
   // t * projectors + p); copied into the arena.
-  [[nodiscard]] static Result<Demultiplexer> create(const DemuxLayout& layout,
-                                                    std::span<const std::uint16_t> predictedAngles,
-                                                    Arena& arena);
+  [[nodiscard]] static Result<Demultiplexer> create(
+      const DemuxLayout& layout, std::span<const std::uint16_t> predictedAngles, Arena& arena,
+      DemuxSchedule schedule = DemuxSchedule::kAutomatic);
 
   // Per frame: every projector's boundaries and directions. The image must be width × height.
   [[nodiscard]] Result<void> run(ConstRgbView image);

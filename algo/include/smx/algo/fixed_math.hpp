@@ -9,7 +9,7 @@
 #include <limits>
 #include <numbers>
 
-#include "smx/algo/fixed.hpp"
+#include "smx/algo/rounding.hpp"
 
 namespace smx::algo {
 
@@ -74,14 +74,15 @@ struct BinAngle {
 
 // sin and cos of a binary angle.
 //   Input   BinAngle (16 bits per turn).
-//   Output  Q<1, 14>; exactly 0 and +-1 at the multiples of π/2; sin(-a) == -sin(a) and
+//   Output  Q1.14 in an int16 (16384 = 1); exactly 0 and +-1 at the multiples of π/2; sin(-a) ==
+//   -sin(a) and
 //           cos(a) == sin(a + π/2) bit for bit.
 //   Method  quarter-wave table, 257 points of sin in Q1.30 (int32), linear interpolation between
 //           them on the remaining 6 bits in an int64 accumulator, then one HalfUp rounding of the
 //           magnitude to Q1.14. Nothing saturates (|result| <= 16384).
 //   Error   <= 0.5 LSB rounding + 0.077 LSB interpolation (h^2/8, h = π/512): bound 0.58 LSB.
-[[nodiscard]] Q<1, 14> sin(BinAngle angle) noexcept;
-[[nodiscard]] Q<1, 14> cos(BinAngle angle) noexcept;
+[[nodiscard]] std::int16_t sin(BinAngle angle) noexcept;
+[[nodiscard]] std::int16_t cos(BinAngle angle) noexcept;
 
 // Angle of the vector (x, y), as std::atan2(y, x), wrapped into [0, 2π) as a BinAngle.
 //   Input   int32 or int64 (the doubled-angle structure tensor feeds gx²−gy² and 2·gx·gy as int64);

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <span>
 
-#include "smx/algo/fixed.hpp"
 #include "smx/algo/image_view.hpp"
+#include "smx/algo/rounding.hpp"
 #include "smx/hal/error.hpp"
 
 // Wire formats a V4L2 camera delivers, converted into the 8-bit RGB frames the pipeline takes.
@@ -28,11 +28,12 @@ namespace detail {
 
 inline constexpr int kYuvFracBits = 16;
 
-// Q2.16: the largest coefficient (B from Cb) is 2.02.
-using YuvCoefficient = algo::Q<2, kYuvFracBits>;
-
+// A coefficient in Q2.16 (an int32 in [-2^18, 2^18)): the largest (B from Cb) is 2.02.
 consteval std::int32_t yuvCoefficient(double value) {
-  return YuvCoefficient::fromDouble(value, algo::Round::kHalfEven).raw();
+  constexpr std::int64_t kLimit = std::int64_t{1} << (2 + kYuvFracBits);
+  return static_cast<std::int32_t>(
+      algo::detail::roundDouble(value * static_cast<double>(std::int64_t{1} << kYuvFracBits),
+                                algo::Round::kHalfEven, -kLimit, kLimit - 1));
 }
 
 inline constexpr double kKr = 0.299;

@@ -1,4 +1,5 @@
-// Stage 1 and the colour averages of stage 4.
+// Stage 1 and the colour averages of stage 4: the schedule of smoothChannels() (reference:
+// reference/smooth.cpp) and the tile colour sums and inverses, which are plain loops already.
 //   Input   8-bit RGB.
 //   Output  int16 planes, 16 × smoothed grey (0…4080): the 3×3 binomial kernel sums to 16; a
 //           second pass (5×5 binomial overall, σ = 1 px) is rounded back by >> 4.

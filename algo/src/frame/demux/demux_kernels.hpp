@@ -1,7 +1,9 @@
 #pragma once
 
-// The per-frame stages of orientation demultiplexing (demux.hpp), one file each. Integer only,
-// no allocation: every buffer is passed in, carved from the arena at create().
+// The per-frame stages of orientation demultiplexing (demux.hpp) as run() calls them: their
+// schedules, one file each in schedule/, each with its plain scalar definition in reference/
+// (demux_reference.hpp). Integer only, no allocation: every buffer is passed in, carved from the
+// arena at create().
 
 #include <array>
 #include <cstdint>

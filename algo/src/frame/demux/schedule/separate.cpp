@@ -1,5 +1,6 @@
-// Stage 3: pattern separation by steered derivatives (paper eqs 6–10), every projector in one
-// sweep over the rows. The division by the local colour (§4.3) is detectBoundaries()'.
+// Stage 3, the schedule of separate() (reference: reference/separation.cpp): pattern separation
+// by steered derivatives (paper eqs 6–10), every projector in one sweep over the rows. The
+// division by the local colour (§4.3) is detectBoundaries()'.
 //   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
 //   to the pixel; unit vectors Q1.14 from the table. Presence: the nearest tile's.
 //   Derivatives of S by matched 5-tap separable filters (below), row-streamed: the horizontal
@@ -22,7 +23,6 @@
 #include <cstdint>
 
 #include "demux_kernels.hpp"
-#include "smx/algo/fixed.hpp"
 
 namespace smx::algo::demux {
 

@@ -1,4 +1,5 @@
-// Stages 4–5: division by the local colour, boundary detection and classification.
+// Stages 4–5, the schedule of detectBoundaries() (reference: reference/boundaries.cpp): division
+// by the local colour, boundary detection and classification.
 //   Relative value (per channel, Q4.11): a separated value D times the inverse colour of the
 //   pixel examined (its nearest tile's average over the tile's window); the samples around a
 //   pixel share its divisor. (Averages interpolated between tile centres gave the same
