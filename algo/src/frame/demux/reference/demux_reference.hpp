@@ -11,8 +11,8 @@
 // unusual (int16 high/low products, blends rounded down to even units) these compute the same
 // integer result the plain way, in int32 or int64, and say so.
 //
-// §, eq: the paper, "Multi-Projector Color Structured-Light Vision" (../shared/DESIGN.md maps it
-// to the code), as cited per function; docs/demux.md describes the stages.
+// §, eq: the paper, "Multi-Projector Color Structured-Light Vision", as cited per function;
+// docs/architecture.md maps its sections to the code, docs/demux.md describes the stages.
 
 #include <cstdint>
 #include <span>
