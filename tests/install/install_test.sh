@@ -59,6 +59,14 @@ code=$?
 set -e
 [ "$code" -ne 0 ] || fail "sim found a named scene with the data moved away"
 grep -q STRIPEMUX_DATA_DIR "$work/err" || fail "no hint at STRIPEMUX_DATA_DIR: $(cat "$work/err")"
+# Scenes pointed at, example rigs not: eval must find the rigs nowhere else (a source tree).
+set +e
+env -u STRIPEMUX_DATA_DIR STRIPEMUX_SCENES="$work/moved/scenes" "$tool" eval --out lost-eval \
+  --only scenes --scene plane --supersampling 1 >/dev/null 2>"$work/err"
+code=$?
+set -e
+[ "$code" -ne 0 ] || fail "eval found the example rigs with the data moved away"
+grep -q STRIPEMUX_DATA_DIR "$work/err" || fail "no hint at STRIPEMUX_DATA_DIR: $(cat "$work/err")"
 STRIPEMUX_DATA_DIR=$work/moved "$tool" sim --rig "$work/moved/boards/sim/rig_2proj_1cam.json" \
   --scene plane --out found >/dev/null
 [ -f found/cam0.png ] || fail "STRIPEMUX_DATA_DIR: no render"
