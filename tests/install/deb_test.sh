@@ -51,13 +51,16 @@ version=$("${emulator[@]}" "$root$exe" --version)
 echo "deb_test: $unit starts $exe (version $version) on $board"
 
 if [ "$host_tool" -eq 1 ]; then
-  check_deb stripemux usr/bin/stripemux usr/share/stripemux/scenes/plane.json \
-    usr/share/stripemux/scenes/meshes/bun_zipper.ply usr/share/stripemux/boards/sim/rig_2proj_1cam.json
+  share=usr/share/stripemux
+  check_deb stripemux usr/bin/stripemux "$share/scenes/plane.json" \
+    "$share/scenes/meshes/bun_zipper.ply" "$share/boards/sim/rig_2proj_1cam.json"
   mkdir "$work/run"
   cd "$work/run"
   env -u STRIPEMUX_DATA_DIR -u STRIPEMUX_SCENES "$root/usr/bin/stripemux" sim \
-    --rig "$root/usr/share/stripemux/boards/sim/rig_2proj_1cam.json" --scene plane --out frame \
+    --rig "$root/$share/boards/sim/rig_2proj_1cam.json" --scene plane --out frame \
     >/dev/null
-  [ -f frame/cam0.png ] && [ -f frame/cam0.depth.pfm ] || fail "the unpacked tool rendered nothing"
+  for f in frame/cam0.png frame/cam0.depth.pfm; do
+    [ -f "$f" ] || fail "the unpacked tool did not write $f"
+  done
   echo "deb_test: the unpacked stripemux rendered the named scene plane"
 fi
