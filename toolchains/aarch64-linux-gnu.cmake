@@ -24,3 +24,10 @@ set(CMAKE_CROSSCOMPILING_EMULATOR /usr/bin/qemu-aarch64-static;-L;/)
 # Used by the integer-only check of the per-frame objects (tests/static).
 set(SMX_TARGET_OBJDUMP aarch64-linux-gnu-objdump)
 set(SMX_TARGET_NM aarch64-linux-gnu-nm)
+
+# pkg-config reads the arm64 .pc files of Debian's multiarch -dev packages (libcamera-dev:arm64)
+# and never the host's. Their paths are real paths of this machine (/usr/include,
+# /usr/lib/aarch64-linux-gnu), so no sysroot is prefixed.
+set(ENV{PKG_CONFIG_LIBDIR} /usr/lib/aarch64-linux-gnu/pkgconfig:/usr/share/pkgconfig)
+set(ENV{PKG_CONFIG_SYSROOT_DIR} "")
+set(ENV{PKG_CONFIG_PATH} "")

@@ -4,19 +4,24 @@
 #include <utility>
 
 #include "smx/protocol/rig_json.hpp"
+#include "smx/sim/named_scenes.hpp"
 #include "smx/sim/renderer.hpp"
 #include "smx/sim/scene_json.hpp"
 
 namespace smx::eval {
 
 namespace {
-std::filesystem::path sourceDir() {
-  return SMX_SOURCE_DIR;
+template <typename T>
+T orThrow(std::expected<T, std::string> value) {
+  if (!value) {
+    throw std::runtime_error(value.error());
+  }
+  return *std::move(value);
 }
 }  // namespace
 
 algo::Rig loadExampleRig(const std::string& file) {
-  auto rig = protocol::loadRig(sourceDir() / "boards/sim" / file);
+  auto rig = protocol::loadRig(orThrow(sim::dataDir()) / "boards/sim" / file);
   if (!rig) {
     throw std::runtime_error(rig.error().message());
   }
@@ -24,7 +29,7 @@ algo::Rig loadExampleRig(const std::string& file) {
 }
 
 sim::Scene loadNamedScene(const std::string& name) {
-  auto scene = sim::loadScene(sourceDir() / "hal/sim/scenes" / (name + ".json"));
+  auto scene = sim::loadScene(orThrow(sim::sceneDir()) / (name + ".json"));
   if (!scene) {
     throw std::runtime_error(scene.error().message());
   }
