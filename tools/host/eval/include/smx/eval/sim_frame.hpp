@@ -44,7 +44,8 @@ struct SimFrame {
   std::vector<OwnedPlane<float>> stripe;      // per projector
 };
 
-// The example rig boards/sim/<rigFile> and the named scene hal/sim/scenes/<scene>.json,
+// The example rig boards/sim/<rigFile> and the named scene <scene> of the data folder
+// (sim::dataDir()),
 // optionally modified by `edit`; all projectors on. Throws std::runtime_error with the reason.
 struct SimRequest {
   std::string rigFile = "rig_2proj_1cam.json";
