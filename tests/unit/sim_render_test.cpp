@@ -16,7 +16,7 @@
 
 #include "smx/algo/lens.hpp"
 #include "smx/algo/stripe_code.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/sim/renderer.hpp"
 #include "source_dir.hpp"
 
@@ -32,7 +32,7 @@ using algo::Rgb8;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 algo::Rig exampleRig(const std::string& name) {
-  auto rig = protocol::loadRig(smx::test::sourceDir() / "boards" / "sim" / name);
+  auto rig = config::loadRig(smx::test::sourceDir() / "boards" / "sim" / name);
   if (!rig) {
     ADD_FAILURE() << rig.error().message();
     return {};

@@ -18,16 +18,18 @@
 #include <variant>
 #include <vector>
 
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/mesh_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/scene.hpp"
-#include "smx/sim/scene_json.hpp"
 #include "source_dir.hpp"
 
 namespace smx::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using config::loadScene;
+using config::parseScene;
 using Triangle = std::array<std::uint32_t, 3>;
 
 const fs::path kSourceDir = smx::test::sourceDir();

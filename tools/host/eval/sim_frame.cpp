@@ -3,9 +3,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/renderer.hpp"
-#include "smx/sim/scene_json.hpp"
 
 namespace smx::eval {
 
@@ -16,7 +16,7 @@ std::filesystem::path sourceDir() {
 }  // namespace
 
 algo::Rig loadExampleRig(const std::string& file) {
-  auto rig = protocol::loadRig(sourceDir() / "boards/sim" / file);
+  auto rig = config::loadRig(sourceDir() / "boards/sim" / file);
   if (!rig) {
     throw std::runtime_error(rig.error().message());
   }
@@ -24,7 +24,7 @@ algo::Rig loadExampleRig(const std::string& file) {
 }
 
 sim::Scene loadNamedScene(const std::string& name) {
-  auto scene = sim::loadScene(sourceDir() / "hal/sim/scenes" / (name + ".json"));
+  auto scene = config::loadScene(sourceDir() / "hal/sim/scenes" / (name + ".json"));
   if (!scene) {
     throw std::runtime_error(scene.error().message());
   }

@@ -1,4 +1,4 @@
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 
 #include <array>
 #include <cmath>
@@ -23,16 +23,11 @@
 #include "smx/config/json_text.hpp"
 #include "smx/config/rotation_check.hpp"
 
-namespace smx::protocol {
+namespace smx::config {
 namespace {
 
 using Json = nlohmann::json;
 using Status = std::expected<void, RigError>;
-using config::describe;
-using config::element;
-using config::formatNumber;
-using config::jsonQuote;
-using config::member;
 
 // Physical plausibility (docs/rig-format.md, "Limits"): values no real rig has are typos or
 // hostile, and refusing them here keeps every later allocation and computation bounded.
@@ -64,28 +59,28 @@ constexpr std::array<std::string_view, 3> kPatternKeys = {"angle_deg", "stripe_p
 
 // A rig.json is a few kB and 4 levels deep; the bounds keep a hostile or mistaken input (a video
 // file, /dev/zero, "[[[[...") from costing the board more than a few MB.
-constexpr config::DocumentSpec kRigDocument = {.name = "rig.json",
-                                               .format = kRigFormat,
-                                               .topKeys = kTopKeys,
-                                               .maxBytes = std::size_t{1} << 20U,
-                                               .sizeNote = "",
-                                               .nestingNeeded = 4,
-                                               .maxNesting = 16,
-                                               .otherFormats = {}};
+constexpr DocumentSpec kRigDocument = {.name = "rig.json",
+                                       .format = kRigFormat,
+                                       .topKeys = kTopKeys,
+                                       .maxBytes = std::size_t{1} << 20U,
+                                       .sizeNote = "",
+                                       .nestingNeeded = 4,
+                                       .maxNesting = 16,
+                                       .otherFormats = {}};
 
 std::unexpected<RigError> fail(std::string field, std::string problem) {
   return std::unexpected(RigError{{}, std::move(field), std::move(problem)});
 }
 
-std::unexpected<RigError> fail(config::FieldError e) {
+std::unexpected<RigError> fail(FieldError e) {
   return fail(std::move(e.field), std::move(e.problem));
 }
 
 // Unknown keys are errors; the closest allowed key, or `hint`, is suggested.
-Status checkKeys(const Json& obj, const std::string& path, config::Keys allowed,
+Status checkKeys(const Json& obj, const std::string& path, Keys allowed,
                  std::string_view hint = {}) {
-  if (const auto key = config::unknownKey(obj, allowed)) {
-    return fail(path, config::unknownKeyProblem(*key, allowed, hint));
+  if (const auto key = unknownKey(obj, allowed)) {
+    return fail(path, unknownKeyProblem(*key, allowed, hint));
   }
   return {};
 }
@@ -227,7 +222,7 @@ Status checkWithin(std::span<const double> values, double limit, const std::stri
 }
 
 Status checkRotation(const std::array<double, 9>& r, const std::string& path) {
-  if (auto problem = config::rotationProblem(r)) {
+  if (auto problem = rotationProblem(r)) {
     return fail(path, std::move(*problem));
   }
   return {};
@@ -236,7 +231,7 @@ Status checkRotation(const std::array<double, 9>& r, const std::string& path) {
 class IdRegistry {
  public:
   Status add(const std::string& id, const std::string& path) {
-    if (auto problem = config::identifierProblem(id)) {
+    if (auto problem = identifierProblem(id)) {
       return fail(member(path, "id"), std::move(*problem));
     }
     const auto [it, inserted] = owners_.emplace(id, path);
@@ -473,7 +468,7 @@ std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, const 
 }
 
 std::expected<algo::Rig, RigError> parseRigImpl(std::string_view text) {
-  auto doc = config::parseDocument(text, kRigDocument);
+  auto doc = parseDocument(text, kRigDocument);
   if (!doc) {
     return fail(std::move(doc.error()));
   }
@@ -540,7 +535,7 @@ void writeDevices(std::string& out, std::string_view key, const std::vector<Devi
 }  // namespace
 
 std::string RigError::message() const {
-  return config::errorMessage(file, field, problem);
+  return errorMessage(file, field, problem);
 }
 
 std::expected<algo::Rig, RigError> parseRig(std::string_view jsonText) {
@@ -553,8 +548,7 @@ std::expected<algo::Rig, RigError> parseRig(std::string_view jsonText) {
 }
 
 std::expected<algo::Rig, RigError> loadRig(const std::filesystem::path& path) {
-  return config::loadDocument(path, kRigDocument,
-                              [](const std::string& text) { return parseRig(text); });
+  return loadDocument(path, kRigDocument, [](const std::string& text) { return parseRig(text); });
 }
 
 std::expected<void, RigError> validateRig(const algo::Rig& rig) {
@@ -595,4 +589,4 @@ std::string toJson(const algo::Rig& rig) {
   return out;
 }
 
-}  // namespace smx::protocol
+}  // namespace smx::config

@@ -1,4 +1,4 @@
-#include "smx/sim/scene_json.hpp"
+#include "smx/config/scene_json.hpp"
 
 #include <algorithm>
 #include <array>
@@ -28,16 +28,28 @@
 #include "smx/sim/mesh_io.hpp"
 #include "smx/sim/png_io.hpp"
 
-namespace smx::sim {
+namespace smx::config {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using config::describe;
-using config::element;
-using config::jsonQuote;
-using config::Keys;
-using config::member;
+using sim::Albedo;
+using sim::Box;
+using sim::CameraResponse;
+using sim::CheckerTexture;
+using sim::Cylinder;
+using sim::ImageTexture;
+using sim::Lighting;
+using sim::Mat3;
+using sim::Mesh;
+using sim::Motion;
+using sim::Object;
+using sim::Plane;
+using sim::Pose;
+using sim::Scene;
+using sim::Shape;
+using sim::Sphere;
+using sim::Vec3;
 
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
                                                       "camera_response", "objects"};
@@ -86,29 +98,26 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 10> kShapeSy
 }};
 
 // A rig.json given as the scene is named as such.
-constexpr std::array<config::FormatHint, 1> kOtherFormats = {
+constexpr std::array<FormatHint, 1> kOtherFormats = {
     {{"stripemux-rig/", " (this is a rig.json, not a scene)"}}};
 // A scene.json is a few kB and 7 levels deep (objects[i].albedo.checker.colours[j]). The bounds
 // keep a mistaken input (a mesh or an image given as the scene) from costing much.
-constexpr config::DocumentSpec kSceneDocument = {
-    .name = "scene.json",
-    .format = kSceneFormat,
-    .topKeys = kTopKeys,
-    .maxBytes = std::size_t{1} << 20U,
-    .sizeNote = " (meshes and textures go in their own files)",
-    .nestingNeeded = 7,
-    .maxNesting = 16,
-    .otherFormats = kOtherFormats};
+constexpr DocumentSpec kSceneDocument = {.name = "scene.json",
+                                         .format = kSceneFormat,
+                                         .topKeys = kTopKeys,
+                                         .maxBytes = std::size_t{1} << 20U,
+                                         .sizeNote = " (meshes and textures go in their own files)",
+                                         .nestingNeeded = 7,
+                                         .maxNesting = 16,
+                                         .otherFormats = kOtherFormats};
 
 // --- Reading scene values ---
 
-using config::Range;
-
 // The generic reads, plus the scene's vectors and matrices (Eigen).
-class Reader : public config::FieldReader {
+class Reader : public FieldReader {
  public:
   [[nodiscard]] std::unexpected<SceneError> error() const {
-    const auto e = firstError().value_or(config::FieldError{});
+    const auto e = firstError().value_or(FieldError{});
     return std::unexpected(SceneError{{}, e.field, e.problem});
   }
 
@@ -168,7 +177,7 @@ Mat3 rotationFromDegrees(const Vec3& deg) {
 
 void checkRotation(Reader& r, const Mat3& rotation, const std::string& path) {
   const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rowMajor = rotation;
-  if (auto problem = config::rotationProblem(std::span<const double, 9>(rowMajor.data(), 9))) {
+  if (auto problem = rotationProblem(std::span<const double, 9>(rowMajor.data(), 9))) {
     r.fail(path, std::move(*problem));
   }
 }
@@ -245,7 +254,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
   }
   std::string_view guess;
   for (const auto& [word, type] : kShapeSynonyms) {
-    if (config::equalIgnoringCase(word, name)) {
+    if (equalIgnoringCase(word, name)) {
       guess = type;
     }
   }
@@ -253,7 +262,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
     std::array<std::string_view, kShapeTypes.size()> names{};
     std::transform(kShapeTypes.begin(), kShapeTypes.end(), names.begin(),
                    [](const ShapeType& t) { return t.name; });
-    guess = config::closestWord(name, names);
+    guess = closestWord(name, names);
   }
   r.fail(at, "unknown shape type " + jsonQuote(name) +
                  (guess.empty() ? "" : " (did you mean " + jsonQuote(guess) + "?)") +
@@ -277,8 +286,8 @@ void readShape(Reader& r, const Json& obj, const std::string& objectPath, Shape&
   if (type == nullptr) {
     return;
   }
-  if (const auto key = config::unknownKey(*v, type->keys)) {
-    r.fail(path, config::unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
+  if (const auto key = unknownKey(*v, type->keys)) {
+    r.fail(path, unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
     return;
   }
   if (type->name == "plane") {
@@ -477,7 +486,7 @@ class FileLoader {
     const fs::path file = resolve(mesh.path);
     auto it = meshes_.find(file);
     if (it == meshes_.end()) {
-      auto loaded = loadMesh(file);
+      auto loaded = sim::loadMesh(file);
       if (!loaded) {
         r.fail(field, "cannot load mesh " + loaded.error().message());
         return;
@@ -496,7 +505,7 @@ class FileLoader {
                         (ec ? ec.message() : std::string("no such file")));
       return;
     }
-    const auto image = readPngRgb8(file);
+    const auto image = sim::readPngRgb8(file);
     if (!image) {
       r.fail(field, "cannot load texture " + image.error());
       return;
@@ -567,7 +576,7 @@ void readObjects(Reader& r, const Json& doc, const fs::path& baseDir, Scene& sce
 }
 
 std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs::path& baseDir) {
-  auto parsed = config::parseDocument(text, kSceneDocument);
+  auto parsed = parseDocument(text, kSceneDocument);
   if (!parsed) {
     auto& e = parsed.error();
     return std::unexpected(SceneError{{}, std::move(e.field), std::move(e.problem)});
@@ -575,7 +584,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   const Json& doc = *parsed;
   Reader r;
   Scene scene;
-  r.integer(doc, "", "supersampling", 1, kMaxSceneSupersampling, "samples per pixel side",
+  r.integer(doc, "", "supersampling", 1, sim::kMaxSceneSupersampling, "samples per pixel side",
             scene.supersampling);
   readLighting(r, doc, scene.lighting);
   readCameraResponse(r, doc, scene.camera);
@@ -589,7 +598,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
 }  // namespace
 
 std::string SceneError::message() const {
-  return config::errorMessage(file, field, problem);
+  return errorMessage(file, field, problem);
 }
 
 std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
@@ -603,9 +612,9 @@ std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
 }
 
 std::expected<Scene, SceneError> loadScene(const std::filesystem::path& file) {
-  return config::loadDocument(file, kSceneDocument, [&](const std::string& text) {
+  return loadDocument(file, kSceneDocument, [&](const std::string& text) {
     return parseScene(text, file.parent_path());
   });
 }
 
-}  // namespace smx::sim
+}  // namespace smx::config
