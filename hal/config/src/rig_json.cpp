@@ -6,6 +6,7 @@
 #include <exception>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -15,6 +16,7 @@
 
 #include "smx/algo/demux.hpp"
 #include "smx/algo/pattern_image.hpp"
+#include "smx/config/field_reader.hpp"
 #include "smx/config/identifier.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_keys.hpp"
@@ -27,7 +29,6 @@ namespace smx::config {
 namespace {
 
 using Json = nlohmann::json;
-using Status = std::expected<void, RigError>;
 
 // Physical plausibility (docs/rig-format.md, "Limits"): values no real rig has are typos or
 // hostile, and refusing them here keeps every later allocation and computation bounded.
@@ -68,41 +69,6 @@ constexpr DocumentSpec kRigDocument = {.name = "rig.json",
                                        .maxNesting = 16,
                                        .otherFormats = {}};
 
-std::unexpected<RigError> fail(std::string field, std::string problem) {
-  return std::unexpected(RigError{{}, std::move(field), std::move(problem)});
-}
-
-std::unexpected<RigError> fail(FieldError e) {
-  return fail(std::move(e.field), std::move(e.problem));
-}
-
-// Unknown keys are errors; the closest allowed key, or `hint`, is suggested.
-Status checkKeys(const Json& obj, const std::string& path, Keys allowed,
-                 std::string_view hint = {}) {
-  if (const auto key = unknownKey(obj, allowed)) {
-    return fail(path, unknownKeyProblem(*key, allowed, hint));
-  }
-  return {};
-}
-
-std::expected<double, RigError> readNumber(const Json& v, const std::string& path) {
-  if (!v.is_number()) {
-    return fail(path, "must be a number, got " + describe(v));
-  }
-  const double d = v.get<double>();
-  if (!std::isfinite(d)) {
-    return fail(path, "must be a finite number, got " + formatNumber(d));
-  }
-  return d;
-}
-
-std::expected<std::string, RigError> readString(const Json& v, const std::string& path) {
-  if (!v.is_string()) {
-    return fail(path, "must be a string, got " + describe(v));
-  }
-  return v.get<std::string>();
-}
-
 std::string sizeProblem(double v) {
   if (v != std::floor(v) || v < 1) {
     return "must be a positive integer (pixels), got " + formatNumber(v);
@@ -111,79 +77,104 @@ std::string sizeProblem(double v) {
          std::to_string(kMaxImageSidePx) + " pixels, got " + formatNumber(v);
 }
 
-std::expected<int, RigError> readSize(const Json& v, const std::string& path) {
-  auto d = readNumber(v, path);
-  if (!d) {
-    return std::unexpected(d.error());
+// The generic reads, plus the rig's required fields: rig.json has no defaults, every key of a
+// device is required.
+class Reader : public FieldReader {
+ public:
+  [[nodiscard]] std::unexpected<RigError> error() const {
+    const auto e = firstError().value_or(FieldError{});
+    return std::unexpected(RigError{{}, e.field, e.problem});
   }
-  // 640.0 is accepted: it is an integer, only written differently.
-  if (*d != std::floor(*d) || *d < kMinImageSidePx || *d > kMaxImageSidePx) {
-    return fail(path, sizeProblem(*d));
-  }
-  return static_cast<int>(*d);
-}
 
-template <std::size_t N>
-Status readArray(const Json& v, const std::string& path, std::string_view what,
-                 std::array<double, N>& out) {
-  if (!v.is_array() || v.size() != N) {
-    return fail(path, "must be an array of " + std::to_string(N) + " numbers (" +
-                          std::string(what) + "), got " + describe(v));
-  }
-  for (std::size_t i = 0; i < N; ++i) {
-    auto d = readNumber(v[i], element(path, i));
-    if (!d) {
-      return std::unexpected(d.error());
+  // obj[key], or nullptr and an error when it is missing.
+  const Json* required(const Json& obj, const std::string& path, std::string_view key) {
+    const Json* v = find(obj, key);
+    if (ok() && v == nullptr) {
+      fail(member(path, key), "required field is missing");
     }
-    out[i] = *d;
+    return v;
   }
-  return {};
-}
+
+  void string(const Json& obj, const std::string& path, std::string_view key, std::string& out) {
+    if (const Json* v = required(obj, path, key); v != nullptr) {
+      if (!v->is_string()) {
+        fail(member(path, key), "must be a string, got " + describe(*v));
+        return;
+      }
+      out = v->get<std::string>();
+    }
+  }
+
+  void requiredNumber(const Json& obj, const std::string& path, std::string_view key, double& out) {
+    if (const Json* v = required(obj, path, key); v != nullptr) {
+      out = number(*v, member(path, key), Range::kAny).value_or(out);
+    }
+  }
+
+  // An image side in pixels (640.0 is accepted: it is an integer, only written differently).
+  void size(const Json& obj, const std::string& path, std::string_view key, int& out) {
+    const Json* v = required(obj, path, key);
+    if (v == nullptr) {
+      return;
+    }
+    const std::string at = member(path, key);
+    const auto d = number(*v, at, Range::kAny);
+    if (!d) {
+      return;
+    }
+    if (*d != std::floor(*d) || *d < kMinImageSidePx || *d > kMaxImageSidePx) {
+      fail(at, sizeProblem(*d));
+      return;
+    }
+    out = static_cast<int>(*d);
+  }
+
+  template <std::size_t N>
+  void array(const Json& obj, const std::string& path, std::string_view key, std::string_view what,
+             std::array<double, N>& out) {
+    if (const Json* v = required(obj, path, key); v != nullptr) {
+      out = numbers<N>(*v, member(path, key), what, Range::kAny).value_or(out);
+    }
+  }
+};
 
 // --- value rules, shared by parseRig() and validateRig() ---
 
-Status checkFinite(std::span<const double> values, const std::string& path) {
+void checkFinite(Reader& r, std::span<const double> values, const std::string& path) {
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i])) {
-      return fail(element(path, i), "must be a finite number, got " + formatNumber(values[i]));
+      r.fail(element(path, i), "must be a finite number, got " + formatNumber(values[i]));
     }
   }
-  return {};
 }
 
-Status checkSize(int v, const std::string& path) {
+void checkSize(Reader& r, int v, const std::string& path) {
   if (v < kMinImageSidePx || v > kMaxImageSidePx) {
-    return fail(path, sizeProblem(v));
+    r.fail(path, sizeProblem(v));
   }
-  return {};
 }
 
-Status checkIntrinsics(const std::array<double, 9>& intrinsics, const std::string& path) {
+void checkIntrinsics(Reader& r, const std::array<double, 9>& intrinsics, const std::string& path) {
   for (std::size_t i = 0; i < intrinsics.size(); ++i) {
     const double k = intrinsics[i];
     const std::string got = ", got " + formatNumber(k);
     const std::string at = element(path, i);
     if (i == 0 && !(k > 0)) {
-      return fail(at, "fx must be positive" + got);
-    }
-    if (i == 4 && !(k > 0)) {
-      return fail(at, "fy must be positive" + got);
-    }
-    if (i == 1 && k != 0) {
-      return fail(at, "skew must be 0 (" + std::string(kKStructure) + ")" + got);
-    }
-    if ((i == 3 || i == 6 || i == 7) && k != 0) {
-      return fail(at, "must be 0 (" + std::string(kKStructure) + ")" + got);
-    }
-    if (i == 8 && k != 1) {
-      return fail(at, "must be 1 (" + std::string(kKStructure) + ")" + got);
+      r.fail(at, "fx must be positive" + got);
+    } else if (i == 4 && !(k > 0)) {
+      r.fail(at, "fy must be positive" + got);
+    } else if (i == 1 && k != 0) {
+      r.fail(at, "skew must be 0 (" + std::string(kKStructure) + ")" + got);
+    } else if ((i == 3 || i == 6 || i == 7) && k != 0) {
+      r.fail(at, "must be 0 (" + std::string(kKStructure) + ")" + got);
+    } else if (i == 8 && k != 1) {
+      r.fail(at, "must be 1 (" + std::string(kKStructure) + ")" + got);
     }
   }
-  return {};
 }
 
-// Called after checkIntrinsics: K has its structure, fx and fy are positive.
-Status checkIntrinsicsPlausible(const algo::DeviceModel& d, const std::string& path) {
+// After checkIntrinsics: K has its structure, fx and fy are positive.
+void checkIntrinsicsPlausible(Reader& r, const algo::DeviceModel& d, const std::string& path) {
   struct Entry {
     std::size_t index;
     double lo;
@@ -201,120 +192,91 @@ Status checkIntrinsicsPlausible(const algo::DeviceModel& d, const std::string& p
   for (const auto& e : entries) {
     const double k = d.K[e.index];
     if (k < e.lo || k > e.hi) {
-      return fail(element(path, e.index), std::string(e.what) + " must be from " +
-                                              formatNumber(e.lo) + " to " + formatNumber(e.hi) +
-                                              " pixels, got " + formatNumber(k));
+      r.fail(element(path, e.index), std::string(e.what) + " must be from " + formatNumber(e.lo) +
+                                         " to " + formatNumber(e.hi) + " pixels, got " +
+                                         formatNumber(k));
     }
   }
-  return {};
 }
 
-Status checkWithin(std::span<const double> values, double limit, const std::string& path,
-                   const char* what) {
+void checkWithin(Reader& r, std::span<const double> values, double limit, const std::string& path,
+                 const char* what) {
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (std::abs(values[i]) > limit) {
-      return fail(element(path, i), std::string(what) + " must be from -" + formatNumber(limit) +
-                                        " to " + formatNumber(limit) + ", got " +
-                                        formatNumber(values[i]));
+      r.fail(element(path, i), std::string(what) + " must be from -" + formatNumber(limit) +
+                                   " to " + formatNumber(limit) + ", got " +
+                                   formatNumber(values[i]));
     }
   }
-  return {};
-}
-
-Status checkRotation(const std::array<double, 9>& r, const std::string& path) {
-  if (auto problem = rotationProblem(r)) {
-    return fail(path, std::move(*problem));
-  }
-  return {};
 }
 
 class IdRegistry {
  public:
-  Status add(const std::string& id, const std::string& path) {
+  void add(Reader& r, const std::string& id, const std::string& path) {
     if (auto problem = identifierProblem(id)) {
-      return fail(member(path, "id"), std::move(*problem));
+      r.fail(member(path, "id"), std::move(*problem));
+      return;
     }
     const auto [it, inserted] = owners_.emplace(id, path);
     if (!inserted) {
-      return fail(member(path, "id"), jsonQuote(id) + " is already the id of " + it->second +
-                                          "; ids must be unique across cameras and projectors");
+      r.fail(member(path, "id"), jsonQuote(id) + " is already the id of " + it->second +
+                                     "; ids must be unique across cameras and projectors");
     }
-    return {};
   }
 
  private:
   std::map<std::string, std::string, std::less<>> owners_;
 };
 
-Status checkDevice(const algo::DeviceModel& d, const std::string& path, IdRegistry& ids) {
-  if (auto s = ids.add(d.id, path); !s) {
-    return s;
+// The rules in file order; only the first failure is kept, so later rules may see values an
+// earlier one refused (none of them divides or allocates by a value).
+void checkDevice(Reader& r, const algo::DeviceModel& d, const std::string& path, IdRegistry& ids) {
+  ids.add(r, d.id, path);
+  checkSize(r, d.width, member(path, "width"));
+  checkSize(r, d.height, member(path, "height"));
+  checkFinite(r, d.K, member(path, "K"));
+  checkIntrinsics(r, d.K, member(path, "K"));
+  checkIntrinsicsPlausible(r, d, member(path, "K"));
+  checkFinite(r, d.dist, member(path, "dist"));
+  checkWithin(r, d.dist, kMaxDistortion, member(path, "dist"), "a distortion coefficient");
+  checkFinite(r, d.R, member(path, "R"));
+  if (auto problem = rotationProblem(d.R)) {
+    r.fail(member(path, "R"), std::move(*problem));
   }
-  if (auto s = checkSize(d.width, member(path, "width")); !s) {
-    return s;
-  }
-  if (auto s = checkSize(d.height, member(path, "height")); !s) {
-    return s;
-  }
-  if (auto s = checkFinite(d.K, member(path, "K")); !s) {
-    return s;
-  }
-  if (auto s = checkIntrinsics(d.K, member(path, "K")); !s) {
-    return s;
-  }
-  if (auto s = checkIntrinsicsPlausible(d, member(path, "K")); !s) {
-    return s;
-  }
-  if (auto s = checkFinite(d.dist, member(path, "dist")); !s) {
-    return s;
-  }
-  if (auto s =
-          checkWithin(d.dist, kMaxDistortion, member(path, "dist"), "a distortion coefficient");
-      !s) {
-    return s;
-  }
-  if (auto s = checkFinite(d.R, member(path, "R")); !s) {
-    return s;
-  }
-  if (auto s = checkRotation(d.R, member(path, "R")); !s) {
-    return s;
-  }
-  if (auto s = checkFinite(d.t, member(path, "t")); !s) {
-    return s;
-  }
-  return checkWithin(d.t, kMaxTranslationM, member(path, "t"), "a translation (metres)");
+  checkFinite(r, d.t, member(path, "t"));
+  checkWithin(r, d.t, kMaxTranslationM, member(path, "t"), "a translation (metres)");
 }
 
-Status checkPattern(const algo::Projector& projector, const std::string& path) {
+void checkPattern(Reader& r, const algo::Projector& projector, const std::string& path) {
   const algo::StripePattern& p = projector.pattern;
   const std::array<double, 3> values = {p.angleDeg, p.stripePx, p.offsetPx};
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i])) {
-      return fail(member(path, kPatternKeys[i]),
-                  "must be a finite number, got " + formatNumber(values[i]));
+      r.fail(member(path, kPatternKeys[i]),
+             "must be a finite number, got " + formatNumber(values[i]));
     }
   }
   if (!(p.stripePx > 0)) {
-    return fail(member(path, "stripe_px"), "must be positive, got " + formatNumber(p.stripePx));
-  }
-  if (p.stripePx < kMinStripePx) {
-    return fail(member(path, "stripe_px"),
-                "must be at least 1 (a stripe narrower than a projector pixel cannot be shown), "
-                "got " +
-                    formatNumber(p.stripePx));
+    r.fail(member(path, "stripe_px"), "must be positive, got " + formatNumber(p.stripePx));
+  } else if (p.stripePx < kMinStripePx) {
+    r.fail(member(path, "stripe_px"),
+           "must be at least 1 (a stripe narrower than a projector pixel cannot be shown), got " +
+               formatNumber(p.stripePx));
   }
   if (std::abs(p.angleDeg) > kMaxAngleDeg) {
-    return fail(member(path, "angle_deg"),
-                "must be from -360 to 360 degrees, got " + formatNumber(p.angleDeg));
+    r.fail(member(path, "angle_deg"),
+           "must be from -360 to 360 degrees, got " + formatNumber(p.angleDeg));
+  }
+  if (!r.ok()) {
+    return;  // visibleStripes() needs a finite, positive stripe width
   }
   if (const int visible = algo::visibleStripes(projector); visible < algo::stripe::kWindowStripes) {
-    return fail(path, "shows " + std::to_string(visible) + " whole stripes in the " +
-                          std::to_string(projector.width) + "x" + std::to_string(projector.height) +
-                          " projector image; a stripe is identified by a window of " +
-                          std::to_string(algo::stripe::kWindowStripes) +
-                          ", so stripe_px or offset_px is wrong");
+    r.fail(path, "shows " + std::to_string(visible) + " whole stripes in the " +
+                     std::to_string(projector.width) + "x" + std::to_string(projector.height) +
+                     " projector image; a stripe is identified by a window of " +
+                     std::to_string(algo::stripe::kWindowStripes) +
+                     ", so stripe_px or offset_px is wrong");
   }
-  return {};
 }
 
 // One of the rig's device lists: its key, what one device is called, and how many there may be.
@@ -329,161 +291,111 @@ constexpr DeviceList kProjectorList = {
     "projectors", "projector", algo::kMaxProjectors,
     " (the method separates up to 3 pattern orientations in one image)"};
 
-Status checkCount(std::size_t n, const DeviceList& list) {
+void checkCount(Reader& r, std::size_t n, const DeviceList& list) {
   const std::string path(list.key);
   if (n == 0) {
-    return fail(path, "at least one " + std::string(list.what) + " is required, got none");
+    r.fail(path, "at least one " + std::string(list.what) + " is required, got none");
+  } else if (n > list.most) {
+    r.fail(path, "at most " + std::to_string(list.most) + " " + std::string(list.what) + "s" +
+                     std::string(list.why) + ", got " + std::to_string(n));
   }
-  if (n > list.most) {
-    return fail(path, "at most " + std::to_string(list.most) + " " + std::string(list.what) + "s" +
-                          std::string(list.why) + ", got " + std::to_string(n));
+}
+
+// The value rules of one device, in file order: its own, then a projector's pattern.
+template <class Device>
+void checkAnyDevice(Reader& r, const Device& d, const std::string& path, IdRegistry& ids) {
+  checkDevice(r, d, path, ids);
+  if constexpr (std::is_same_v<Device, algo::Projector>) {
+    if (r.ok()) {
+      checkPattern(r, d, member(path, "pattern"));
+    }
   }
-  return {};
 }
 
 // --- reading: JSON structure -> Rig ---
 
-// Applies `read(value, path)` to obj[key]; a missing key is an error.
-template <class Read>
-auto readField(const Json& obj, const std::string& path, std::string_view key, Read read)
-    -> decltype(read(obj, path)) {
-  const std::string at = member(path, key);
-  const auto it = obj.find(key);
-  if (it == obj.end()) {
-    return fail(at, "required field is missing");
-  }
-  return read(*it, at);
+void readDeviceModel(Reader& r, const Json& obj, const std::string& path, algo::DeviceModel& d) {
+  r.string(obj, path, "id", d.id);
+  r.size(obj, path, "width", d.width);
+  r.size(obj, path, "height", d.height);
+  r.array(obj, path, "K", "row-major 3x3 camera matrix", d.K);
+  r.array(obj, path, "dist", "k1 k2 p1 p2 k3", d.dist);
+  r.array(obj, path, "R", "row-major 3x3 rotation", d.R);
+  r.array(obj, path, "t", "translation in metres", d.t);
 }
 
-template <std::size_t N>
-Status readArrayField(const Json& obj, const std::string& path, std::string_view key,
-                      std::string_view what, std::array<double, N>& out) {
-  return readField(obj, path, key, [&](const Json& v, const std::string& at) {
-    return readArray(v, at, what, out);
-  });
-}
-
-Status readDeviceModel(const Json& obj, const std::string& path, algo::DeviceModel& d) {
-  auto id = readField(obj, path, "id", readString);
-  if (!id) {
-    return std::unexpected(id.error());
-  }
-  d.id = std::move(*id);
-  auto width = readField(obj, path, "width", readSize);
-  if (!width) {
-    return std::unexpected(width.error());
-  }
-  d.width = *width;
-  auto height = readField(obj, path, "height", readSize);
-  if (!height) {
-    return std::unexpected(height.error());
-  }
-  d.height = *height;
-  if (auto s = readArrayField(obj, path, "K", "row-major 3x3 camera matrix", d.K); !s) {
-    return s;
-  }
-  if (auto s = readArrayField(obj, path, "dist", "k1 k2 p1 p2 k3", d.dist); !s) {
-    return s;
-  }
-  if (auto s = readArrayField(obj, path, "R", "row-major 3x3 rotation", d.R); !s) {
-    return s;
-  }
-  return readArrayField(obj, path, "t", "translation in metres", d.t);
-}
-
-Status readPattern(const Json& obj, const std::string& path, algo::StripePattern& p) {
+void readPattern(Reader& r, const Json& obj, const std::string& path, algo::StripePattern& p) {
   if (!obj.is_object()) {
-    return fail(
-        path, R"(must be an object {"angle_deg", "stripe_px", "offset_px"}, got )" + describe(obj));
+    r.fail(path,
+           R"(must be an object {"angle_deg", "stripe_px", "offset_px"}, got )" + describe(obj));
+    return;
   }
-  if (auto s = checkKeys(obj, path, kPatternKeys); !s) {
-    return s;
+  if (!r.object(obj, path, "", kPatternKeys)) {
+    return;
   }
-  const std::array<double*, 3> outs = {&p.angleDeg, &p.stripePx, &p.offsetPx};
-  for (std::size_t i = 0; i < outs.size(); ++i) {
-    auto v = readField(obj, path, kPatternKeys[i], readNumber);
-    if (!v) {
-      return std::unexpected(v.error());
-    }
-    *outs[i] = *v;
-  }
-  return {};
+  r.requiredNumber(obj, path, "angle_deg", p.angleDeg);
+  r.requiredNumber(obj, path, "stripe_px", p.stripePx);
+  r.requiredNumber(obj, path, "offset_px", p.offsetPx);
 }
 
 template <class Device>
-Status readDevice(const Json& obj, const std::string& path, IdRegistry& ids, Device& d) {
+void readDevice(Reader& r, const Json& obj, const std::string& path, const DeviceList& list,
+                IdRegistry& ids, Device& d) {
   constexpr bool kIsProjector = std::is_same_v<Device, algo::Projector>;
-  if (auto s = kIsProjector ? checkKeys(obj, path, kProjectorKeys)
-                            : checkKeys(obj, path, kCameraKeys,
-                                        obj.contains("pattern") ? "cameras have no pattern" : "");
-      !s) {
-    return s;
+  const std::string what = "one " + std::string(list.what);
+  if (!(kIsProjector ? r.object(obj, path, what, kProjectorKeys)
+                     : r.object(obj, path, what, kCameraKeys,
+                                obj.contains("pattern") ? "cameras have no pattern" : ""))) {
+    return;
   }
-  if (auto s = readDeviceModel(obj, path, d); !s) {
-    return s;
-  }
-  if (auto s = checkDevice(d, path, ids); !s) {
-    return s;
+  readDeviceModel(r, obj, path, d);
+  if (r.ok()) {
+    checkDevice(r, d, path, ids);
   }
   if constexpr (kIsProjector) {
-    const std::string at = member(path, "pattern");
-    if (auto s = readField(
-            obj, path, "pattern",
-            [&](const Json& v, const std::string&) { return readPattern(v, at, d.pattern); });
-        !s) {
-      return s;
+    if (const Json* pattern = r.required(obj, path, "pattern"); pattern != nullptr) {
+      readPattern(r, *pattern, member(path, "pattern"), d.pattern);
     }
-    return checkPattern(d, at);
+    if (r.ok()) {
+      checkPattern(r, d, member(path, "pattern"));
+    }
   }
-  return {};
 }
 
 template <class Device>
-std::expected<std::vector<Device>, RigError> readDevices(const Json& doc, const DeviceList& list,
-                                                         IdRegistry& ids) {
+std::vector<Device> readDevices(Reader& r, const Json& doc, const DeviceList& list,
+                                IdRegistry& ids) {
   const std::string path(list.key);
-  const std::string what(list.what);
-  const auto it = doc.find(list.key);
-  if (it == doc.end()) {
-    return fail(path, "required field is missing");
+  const Json* devices = r.required(doc, "", list.key);
+  if (devices == nullptr) {
+    return {};
   }
-  if (!it->is_array()) {
-    return fail(path, "must be an array of " + what + "s, got " + describe(*it));
+  if (!devices->is_array()) {
+    r.fail(path, "must be an array of " + std::string(list.what) + "s, got " + describe(*devices));
+    return {};
   }
-  if (auto s = checkCount(it->size(), list); !s) {
-    return std::unexpected(s.error());
+  checkCount(r, devices->size(), list);
+  std::vector<Device> out(r.ok() ? devices->size() : 0);
+  for (std::size_t i = 0; i < out.size() && r.ok(); ++i) {
+    readDevice(r, (*devices)[i], element(path, i), list, ids, out[i]);
   }
-  std::vector<Device> devices(it->size());
-  for (std::size_t i = 0; i < devices.size(); ++i) {
-    const Json& obj = (*it)[i];
-    const std::string at = element(path, i);
-    if (!obj.is_object()) {
-      return fail(at, "must be an object (one " + what + "), got " + describe(obj));
-    }
-    if (auto s = readDevice(obj, at, ids, devices[i]); !s) {
-      return std::unexpected(s.error());
-    }
-  }
-  return devices;
+  return out;
 }
 
 std::expected<algo::Rig, RigError> parseRigImpl(std::string_view text) {
   auto doc = parseDocument(text, kRigDocument);
   if (!doc) {
-    return fail(std::move(doc.error()));
+    return std::unexpected(
+        RigError{{}, std::move(doc.error().field), std::move(doc.error().problem)});
   }
+  Reader r;
   IdRegistry ids;
   algo::Rig rig;
-  auto cameras = readDevices<algo::Camera>(*doc, kCameraList, ids);
-  if (!cameras) {
-    return std::unexpected(cameras.error());
+  rig.cameras = readDevices<algo::Camera>(r, *doc, kCameraList, ids);
+  rig.projectors = readDevices<algo::Projector>(r, *doc, kProjectorList, ids);
+  if (!r.ok()) {
+    return r.error();
   }
-  rig.cameras = std::move(*cameras);
-  auto projectors = readDevices<algo::Projector>(*doc, kProjectorList, ids);
-  if (!projectors) {
-    return std::unexpected(projectors.error());
-  }
-  rig.projectors = std::move(*projectors);
   return rig;
 }
 
@@ -543,7 +455,7 @@ std::expected<algo::Rig, RigError> parseRig(std::string_view jsonText) {
     return parseRigImpl(jsonText);
   } catch (const std::exception& e) {
     // Out of memory or a library surprise: still an error value, never an exception.
-    return fail("", std::string("cannot read the rig: ") + e.what());
+    return std::unexpected(RigError{{}, {}, std::string("cannot read the rig: ") + e.what()});
   }
 }
 
@@ -553,30 +465,24 @@ std::expected<algo::Rig, RigError> loadRig(const std::filesystem::path& path) {
 
 std::expected<void, RigError> validateRig(const algo::Rig& rig) {
   try {
+    Reader r;
     IdRegistry ids;
-    if (auto s = checkCount(rig.cameras.size(), kCameraList); !s) {
-      return s;
+    checkCount(r, rig.cameras.size(), kCameraList);
+    for (std::size_t i = 0; i < rig.cameras.size() && r.ok(); ++i) {
+      checkAnyDevice(r, rig.cameras[i], element("cameras", i), ids);
     }
-    for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
-      if (auto s = checkDevice(rig.cameras[i], element("cameras", i), ids); !s) {
-        return s;
-      }
+    if (r.ok()) {
+      checkCount(r, rig.projectors.size(), kProjectorList);
     }
-    if (auto s = checkCount(rig.projectors.size(), kProjectorList); !s) {
-      return s;
+    for (std::size_t i = 0; i < rig.projectors.size() && r.ok(); ++i) {
+      checkAnyDevice(r, rig.projectors[i], element("projectors", i), ids);
     }
-    for (std::size_t i = 0; i < rig.projectors.size(); ++i) {
-      const std::string at = element("projectors", i);
-      if (auto s = checkDevice(rig.projectors[i], at, ids); !s) {
-        return s;
-      }
-      if (auto s = checkPattern(rig.projectors[i], member(at, "pattern")); !s) {
-        return s;
-      }
+    if (!r.ok()) {
+      return r.error();
     }
     return {};
   } catch (const std::exception& e) {
-    return fail("", std::string("cannot check the rig: ") + e.what());
+    return std::unexpected(RigError{{}, {}, std::string("cannot check the rig: ") + e.what()});
   }
 }
 

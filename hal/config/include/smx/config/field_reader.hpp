@@ -16,7 +16,7 @@
 #include "smx/config/json_text.hpp"
 
 // Typed reads of configuration values with errors that name the field, shared by the readers of
-// scene.json and board.json (rig.json predates it).
+// rig.json, board.json and scene.json.
 namespace smx::config {
 
 enum class Range : std::uint8_t { kAny, kPositive, kNonNegative, kFraction };
@@ -24,7 +24,7 @@ enum class Range : std::uint8_t { kAny, kPositive, kNonNegative, kFraction };
 // Reads values into a document whose members already hold the defaults, and keeps the first
 // problem: once one is found the remaining reads do nothing, so the reading code stays a plain
 // sequence and the report is the first problem in reading order. Readers of one document kind
-// (scene.json, board.json) derive from it for their own types.
+// (rig.json, board.json, scene.json) derive from it for their own types.
 class FieldReader {
  public:
   [[nodiscard]] bool ok() const { return !error_.has_value(); }
@@ -36,9 +36,10 @@ class FieldReader {
     }
   }
 
-  // `v` must be an object (`what`, for the message) holding only `allowed` keys.
-  bool object(const nlohmann::json& v, const std::string& path, std::string_view what,
-              Keys allowed) {
+  // `v` must be an object (`what`, for the message) holding only `allowed` keys; `hint` is said
+  // about an unknown key when no allowed key is close to it.
+  bool object(const nlohmann::json& v, const std::string& path, std::string_view what, Keys allowed,
+              std::string_view hint = {}) {
     if (!ok()) {
       return false;
     }
@@ -47,7 +48,7 @@ class FieldReader {
       return false;
     }
     if (const auto key = config::unknownKey(v, allowed)) {
-      fail(path, config::unknownKeyProblem(*key, allowed));
+      fail(path, config::unknownKeyProblem(*key, allowed, hint));
       return false;
     }
     return true;
