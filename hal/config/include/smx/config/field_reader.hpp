@@ -72,6 +72,14 @@ class FieldReader {
       return std::nullopt;
     }
     const double d = v.get<double>();
+    return check(d, path, range) ? std::optional<double>(d) : std::nullopt;
+  }
+
+  // The rule of `range` for a value already read: what number() says of the same value.
+  bool check(double d, const std::string& path, Range range) {
+    if (!ok()) {
+      return false;
+    }
     const std::string got = ", got " + formatNumber(d);
     if (!std::isfinite(d)) {
       fail(path, "must be a finite number" + got);
@@ -82,9 +90,18 @@ class FieldReader {
     } else if (range == Range::kFraction && (d < 0 || d > 1)) {
       fail(path, "must be between 0 and 1" + got);
     } else {
-      return d;
+      return true;
     }
-    return std::nullopt;
+    return false;
+  }
+
+  // check() of every element, element(path, i) naming it.
+  template <class Values>
+  void checkEach(const Values& values, const std::string& path, Range range) {
+    std::size_t i = 0;
+    for (const double d : values) {
+      check(d, element(path, i++), range);
+    }
   }
 
   void number(const nlohmann::json& obj, const std::string& path, std::string_view key, Range range,
@@ -107,11 +124,17 @@ class FieldReader {
       return;
     }
     if (*d != std::floor(*d) || *d < lo || *d > hi) {
-      fail(at, "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) +
-                   " (" + std::string(what) + "), got " + formatNumber(*d));
+      fail(at, integerProblem(*d, lo, hi, what));
       return;
     }
     out = static_cast<int>(*d);
+  }
+
+  // The rule of integer() for a value already read.
+  void check(int v, const std::string& path, int lo, int hi, std::string_view what) {
+    if (v < lo || v > hi) {
+      fail(path, integerProblem(v, lo, hi, what));
+    }
   }
 
   void boolean(const nlohmann::json& obj, const std::string& path, std::string_view key,
@@ -169,6 +192,11 @@ class FieldReader {
   }
 
  private:
+  static std::string integerProblem(double v, int lo, int hi, std::string_view what) {
+    return "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + " (" +
+           std::string(what) + "), got " + formatNumber(v);
+  }
+
   std::optional<FieldError> error_;
 };
 

@@ -35,6 +35,13 @@ struct SceneError {
 [[nodiscard]] std::expected<sim::Scene, SceneError> parseScene(
     std::string_view jsonText, const std::filesystem::path& baseDir);
 
+// The value rules of scene.json applied to a scene built in memory or changed after reading:
+// ranges, rotations, supersampling 1 to sim::kMaxSceneSupersampling, at least one object, and
+// meshes and textures loaded. parseScene() applies the same rules as it reads (object names are
+// checked only there: they are the file's); the renderer refuses every scene this refuses, with
+// this message, and no other. Field paths are as in the JSON.
+[[nodiscard]] std::expected<void, SceneError> validateScene(const sim::Scene& scene);
+
 // Reads `file` and parses it with baseDir = the file's directory; an unreadable file is an error
 // (SceneError::file names it, as it does for every error found in the file).
 [[nodiscard]] std::expected<sim::Scene, SceneError> loadScene(const std::filesystem::path& file);
