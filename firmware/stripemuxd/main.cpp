@@ -10,7 +10,7 @@
 #include <ctime>
 #include <thread>
 
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/discovery.hpp"
@@ -58,7 +58,7 @@ void printCounters(const Device& device, const char* prefix) {
 }
 
 int run(const Options& opts) {
-  auto board = smx::board::loadBoard(opts.board);
+  auto board = smx::config::loadBoard(opts.board);
   if (!board) {
     std::fprintf(stderr, "stripemuxd: %s\n", board.error().message().c_str());
     return 2;

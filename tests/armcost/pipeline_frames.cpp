@@ -22,8 +22,8 @@
 
 #include "ppm_io.hpp"
 #include "smx/algo/camera_pipeline.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/protocol/messages.hpp"
-#include "smx/protocol/rig_json.hpp"
 
 namespace {
 
@@ -84,7 +84,7 @@ std::pair<std::int64_t, const char*> lastStageResult(const algo::CameraPipeline&
 }
 
 int run(const Options& opts) {
-  auto rig = protocol::loadRig(opts.rig);
+  auto rig = config::loadRig(opts.rig);
   if (!rig) {
     std::fprintf(stderr, "pipeline_frames: %s\n", rig.error().message().c_str());
     return kExitBadInput;

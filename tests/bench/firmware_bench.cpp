@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "replay_board.hpp"
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/hal/steady_clock.hpp"
@@ -90,7 +90,7 @@ class Host {
 
 void BM_FirmwareLoop(benchmark::State& state) {
   const auto cameras = static_cast<std::size_t>(state.range(0));
-  const board::Board board = test::replayBoard(static_cast<int>(cameras), 5);
+  const config::Board board = test::replayBoard(static_cast<int>(cameras), 5);
   auto boardHal = hal::createBoardHal(board.config, board.rig).value();
   device::DeviceOptions options;
   options.decodeThreads = static_cast<int>(state.range(1));

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/renderer.hpp"
-#include "smx/sim/scene_json.hpp"
 #include "source_dir.hpp"
 
 namespace {
@@ -24,8 +24,8 @@ struct Setup {
 
 Setup load(const std::string& rigName, const std::string& sceneName, int supersampling) {
   const std::string root = smx::test::sourceDir().string();
-  auto rig = smx::protocol::loadRig(root + "/boards/sim/" + rigName + ".json");
-  auto scene = smx::sim::loadScene(root + "/hal/sim/scenes/" + sceneName + ".json");
+  auto rig = smx::config::loadRig(root + "/boards/sim/" + rigName + ".json");
+  auto scene = smx::config::loadScene(root + "/hal/sim/scenes/" + sceneName + ".json");
   if (!rig || !scene) {
     std::fprintf(stderr, "cannot load %s / %s\n", rigName.c_str(), sceneName.c_str());
     std::abort();

@@ -1,4 +1,4 @@
-// libFuzzer target for board.json (smx::board::parseBoard): any text is a board or a BoardError,
+// libFuzzer target for board.json (smx::config::parseBoard): any text is a board or a BoardError,
 // never a crash or a sanitizer report. Relative paths in the input (the rig, a replay folder)
 // resolve in tests/fuzz/files, where the seeds' rig is.
 #include <cstddef>
@@ -6,11 +6,11 @@
 #include <string_view>
 
 #include "fuzz_files.hpp"
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const auto dir = smx::fuzz::filesDir();
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  (void)smx::board::parseBoard(text, dir);
+  (void)smx::config::parseBoard(text, dir);
   return 0;
 }

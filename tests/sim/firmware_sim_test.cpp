@@ -15,12 +15,12 @@
 #include "cli.hpp"
 #include "device_client.hpp"
 #include "replay_board.hpp"
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
-#include "smx/protocol/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/sim_board.hpp"
 #include "source_dir.hpp"
@@ -44,8 +44,8 @@ int cli(const std::vector<std::string>& args) {
 
 // The sim board replaying its rig's renders, with a small send buffer so that a slow host is
 // felt after a few frames.
-board::Board simBoard(int cameras) {
-  board::Board board = test::replayBoard(cameras, kReplayFrames);
+config::Board simBoard(int cameras) {
+  config::Board board = test::replayBoard(cameras, kReplayFrames);
   board.config.network.sendBufferBytes = 64 * 1024;
   return board;
 }
@@ -80,7 +80,7 @@ struct RunningDevice {
   }
   [[nodiscard]] sim::SimBoardControl& control() const { return *sim::simBoardControl(*boardHal); }
 
-  board::Board board;
+  config::Board board;
   std::unique_ptr<hal::BoardHal> boardHal;
   std::unique_ptr<device::Device> device;
   std::atomic<bool> stopNetwork = false;

@@ -8,7 +8,7 @@
 
 #include "alloc_counter.hpp"
 #include "png_claim.hpp"
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "source_dir.hpp"
 
@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 // (1.2 GB as RGB), when the board's HAL is created, then it fails naming the file, its claim and
 // the camera's 640x480, having allocated nothing near the claim.
 TEST(SimReplay, FrameClaimingAHugeSizeIsRefusedNamingTheFileAndBothSizes) {
-  auto board = board::loadBoard(test::sourceDir() / "boards/sim");
+  auto board = config::loadBoard(test::sourceDir() / "boards/sim");
   ASSERT_TRUE(board.has_value()) << board.error().message();
   const fs::path dir = fs::temp_directory_path() / "smx_replay_png_test";
   fs::remove_all(dir);

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 #include "source_dir.hpp"
 
 namespace smx::test {
@@ -46,12 +46,12 @@ fs::path replayFrames(int cameras, int frames) {
   return dir;
 }
 
-board::Board replayBoard(int cameras, int frames) {
-  auto loaded = board::loadBoard(boardsDir() / "sim");
+config::Board replayBoard(int cameras, int frames) {
+  auto loaded = config::loadBoard(boardsDir() / "sim");
   if (!loaded) {
     throw std::runtime_error(loaded.error().message());
   }
-  board::Board board = std::move(*loaded);
+  config::Board board = std::move(*loaded);
   board.config.sim.scene.clear();
   board.config.sim.replayDir = replayFrames(cameras, frames);
   board.config.network.port = 0;
@@ -59,7 +59,7 @@ board::Board replayBoard(int cameras, int frames) {
     camera.format.fps = 1000;
   }
   if (cameras == 1) {
-    board.rig = protocol::loadRig(boardsDir() / "sim" / replayRigFile(1)).value();
+    board.rig = config::loadRig(boardsDir() / "sim" / replayRigFile(1)).value();
     board.config.cameras.resize(1);
   }
   return board;

@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <string>
 
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 
 // Test support, host only: the simulated board replaying turntable frames rendered by its own
 // rig, so the firmware's tests and benchmarks decode real depth without the renderer's cost.
@@ -18,6 +18,6 @@ namespace smx::test {
 
 // boards/sim replaying those frames on a free loopback port, its cameras at 1000 fps (the loop,
 // not the sensor, sets the pace); with 1 camera, the 1-camera rig. Throws on failure.
-[[nodiscard]] board::Board replayBoard(int cameras, int frames);
+[[nodiscard]] config::Board replayBoard(int cameras, int frames);
 
 }  // namespace smx::test

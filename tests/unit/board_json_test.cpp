@@ -1,4 +1,4 @@
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "source_dir.hpp"
 
-namespace smx::board {
+namespace smx::config {
 namespace {
 
 const std::filesystem::path kBoards = smx::test::sourceDir() / "boards";
@@ -114,4 +114,4 @@ TEST(BoardJson, AMissingFileIsNamed) {
 }
 
 }  // namespace
-}  // namespace smx::board
+}  // namespace smx::config

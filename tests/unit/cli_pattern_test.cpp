@@ -7,7 +7,7 @@
 #include "cli.hpp"
 #include "cli_harness.hpp"
 #include "pattern_sampler.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
 #include "source_dir.hpp"
 
@@ -35,7 +35,7 @@ TEST_F(CliPattern, WritesEachProjectorsPatternRecoverableAlongItsAxis) {
     const auto out = dir_ / name;
     const auto result = run({"pattern", "--rig", rigPath.string(), "--out", out.string()});
     ASSERT_EQ(result.code, kExitOk) << result.err;
-    const auto rig = protocol::loadRig(rigPath);
+    const auto rig = config::loadRig(rigPath);
     ASSERT_TRUE(rig.has_value());
     for (const auto& projector : rig->projectors) {
       const auto image = sim::readPngRgb8(out / (projector.id + ".png"));

@@ -1,6 +1,6 @@
 // rig.json (`stripemux-rig/1`): reading, the validation rules with their messages, writing, and
 // the example rigs in boards/sim. Format: docs/rig-format.md.
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,7 +20,7 @@
 
 #include "source_dir.hpp"
 
-namespace smx::protocol {
+namespace smx::config {
 namespace {
 
 namespace fs = std::filesystem;
@@ -854,4 +854,4 @@ std::string rigTestName(const ::testing::TestParamInfo<std::string>& param) {
 INSTANTIATE_TEST_SUITE_P(BoardsSim, ExampleRig, ::testing::ValuesIn(kExampleRigs), rigTestName);
 
 }  // namespace
-}  // namespace smx::protocol
+}  // namespace smx::config

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -16,7 +17,8 @@
 
 #include "smx/algo/lens.hpp"
 #include "smx/algo/stripe_code.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/renderer.hpp"
 #include "source_dir.hpp"
 
@@ -32,7 +34,7 @@ using algo::Rgb8;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 algo::Rig exampleRig(const std::string& name) {
-  auto rig = protocol::loadRig(smx::test::sourceDir() / "boards" / "sim" / name);
+  auto rig = config::loadRig(smx::test::sourceDir() / "boards" / "sim" / name);
   if (!rig) {
     ADD_FAILURE() << rig.error().message();
     return {};
@@ -1018,6 +1020,126 @@ TEST(RenderErrors, RejectsEmptyMeshAndBadSupersampling) {
   scene.objects.clear();
   scene.supersampling = 0;
   EXPECT_FALSE(Renderer::create(rig, scene).has_value());
+}
+
+// ---- One validation: the renderer draws what scene.json accepts and refuses the rest ----
+
+// A plane facing the camera, written as scene.json with the given supersampling.
+std::string planeSceneJson(int supersampling) {
+  return R"({"format": "stripemux-scene/1", "supersampling": )" + std::to_string(supersampling) +
+         R"(, "objects": [{"shape": {"type": "plane"}, "pose": {"t": [0, 0, 0.9]}}]})";
+}
+
+// Given the largest supersampling scene.json allows, when read and rendered, then it renders; one
+// more is refused by the reader (naming the file and the field) and by the renderer, in the same
+// words: the limit is one value.
+TEST(RenderSceneRules, SupersamplingLimitIsOneValue) {
+  const algo::Rig rig = smallRig("rig_2proj_1cam.json", 8);
+  const auto atLimit = config::parseScene(planeSceneJson(kMaxSceneSupersampling), ".");
+  ASSERT_TRUE(atLimit.has_value()) << atLimit.error().message();
+  ASSERT_EQ(atLimit->supersampling, kMaxSceneSupersampling);
+  auto renderer = makeRenderer(rig, *atLimit);
+  ASSERT_NE(renderer, nullptr);
+  const Frame f = renderFrame(*renderer, rig, request(rig));
+  EXPECT_GT(f.px(f.width / 2, f.height / 2).r + f.px(f.width / 2, f.height / 2).g, 0);
+
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "smx_render_supersampling_over_limit.json";
+  {
+    std::ofstream out(file);
+    out << planeSceneJson(kMaxSceneSupersampling + 1);
+  }
+  const auto overLimit = config::loadScene(file);
+  std::filesystem::remove(file);
+  ASSERT_FALSE(overLimit.has_value());
+  EXPECT_EQ(overLimit.error().file, file.string());
+  EXPECT_EQ(overLimit.error().field, "supersampling");
+  EXPECT_EQ(overLimit.error().problem,
+            "must be an integer from 1 to " + std::to_string(kMaxSceneSupersampling) +
+                " (samples per pixel side), got " + std::to_string(kMaxSceneSupersampling + 1));
+
+  Scene over = *atLimit;
+  over.supersampling = kMaxSceneSupersampling + 1;
+  const auto refused = Renderer::create(rig, over);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_EQ(refused.error(), "supersampling: " + overLimit.error().problem);
+}
+
+// Given scenes at and just beyond the edges of scene.json's value rules, when validated and given
+// to the renderer, then the renderer accepts exactly the scenes validateScene() accepts and
+// refuses the others with its message.
+TEST(RenderSceneRules, RendererRefusesExactlyWhatTheValidatorRefuses) {
+  const algo::Rig rig = smallRig("rig_2proj_1cam.json", 8);
+  const auto base = [] {
+    Scene s = quietScene();
+    s.objects.push_back(makeObject(Sphere{0.1}, Mat3::Identity(), {0, 0, 0.9}));
+    return s;
+  };
+  struct Case {
+    const char* name;
+    std::function<void(Scene&)> change;
+    bool valid;
+  };
+  const std::vector<Case> cases = {
+      {"as is", [](Scene&) {}, true},
+      {"supersampling 1", [](Scene& s) { s.supersampling = 1; }, true},
+      {"supersampling 0", [](Scene& s) { s.supersampling = 0; }, false},
+      {"limit + 1", [](Scene& s) { s.supersampling = kMaxSceneSupersampling + 1; }, false},
+      {"ambient 1", [](Scene& s) { s.lighting.ambient = Vec3::Ones(); }, true},
+      {"ambient above 1", [](Scene& s) { s.lighting.ambient.y() = 1.5; }, false},
+      {"no inverse square, distance 0",
+       [](Scene& s) {
+         s.lighting.inverseSquare = false;
+         s.lighting.referenceDistanceM = 0;
+       },
+       false},
+      {"projector power 0", [](Scene& s) { s.lighting.projectorPower = 0; }, false},
+      {"negative defocus", [](Scene& s) { s.camera.defocusSigmaPx = -0.5; }, false},
+      {"gain NaN", [](Scene& s) { s.camera.gain = kNaN; }, false},
+      {"negative crosstalk", [](Scene& s) { s.camera.crosstalk(0, 1) = -0.1; }, true},
+      {"albedo 1", [](Scene& s) { s.objects[0].albedo.rgb = Vec3::Ones(); }, true},
+      {"albedo above 1", [](Scene& s) { s.objects[0].albedo.rgb.x() = 1.01; }, false},
+      {"radius 0", [](Scene& s) { s.objects[0].shape = Sphere{0.0}; }, false},
+      {"reflection", [](Scene& s) { s.objects[0].pose.R(0, 0) = -1; }, false},
+      {"scale 0", [](Scene& s) { s.objects[0].pose.scale = 0; }, false},
+      {"still object, zero axis", [](Scene& s) { s.objects[0].motion.axis = Vec3::Zero(); }, false},
+      {"turning, long axis",
+       [](Scene& s) {
+         s.objects[0].motion.axis = {0, 1e6, 0};
+         s.objects[0].motion.angularDegPerFrame = 5;
+       },
+       true},
+      {"no objects", [](Scene& s) { s.objects.clear(); }, false},
+      {"empty mesh",
+       [](Scene& s) {
+         s.objects[0].shape = Mesh{"x.ply", {}, {}};
+       },
+       false},
+      {"checker without colours",
+       [](Scene& s) {
+         s.objects[0].albedo.texture = CheckerTexture{0.04, {}};
+       },
+       false},
+      {"texture not loaded",
+       [](Scene& s) {
+         ImageTexture notLoaded;
+         notLoaded.path = "t.png";
+         s.objects[0].albedo.texture = notLoaded;
+       },
+       false},
+  };
+  for (const auto& c : cases) {
+    Scene scene = base();
+    c.change(scene);
+    const auto valid = config::validateScene(scene);
+    EXPECT_EQ(valid.has_value(), c.valid) << c.name;
+    const auto renderer = Renderer::create(rig, scene);
+    ASSERT_EQ(renderer.has_value(), valid.has_value())
+        << c.name << ": " << (renderer ? valid.error().message() : renderer.error());
+    if (!valid) {
+      EXPECT_EQ(renderer.error(), valid.error().message()) << c.name;
+    }
+  }
 }
 
 }  // namespace

@@ -18,16 +18,18 @@
 #include <variant>
 #include <vector>
 
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/mesh_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/scene.hpp"
-#include "smx/sim/scene_json.hpp"
 #include "source_dir.hpp"
 
 namespace smx::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using config::loadScene;
+using config::parseScene;
 using Triangle = std::array<std::uint32_t, 3>;
 
 const fs::path kSourceDir = smx::test::sourceDir();
@@ -993,6 +995,68 @@ TEST(MeshErrors, ObjIndicesInRange) {
                      {"line 3: face refers to vertex 7, but the file has 3 vertices"});
   expectMeshRejected("v 0 0 0\nv 1 0 0\nv 0 1 0\n# no faces\n", MeshFormat::kObj,
                      {"no triangles: the file has no faces (\"f\" lines)"});
+}
+
+// ---- validateScene(): the value rules for scenes built in memory ----
+
+// Given every shipped scene, when read, then validateScene() accepts what parseScene() returned:
+// reading applies the same rules and leaves nothing (an unnormalised axis, a default) they refuse.
+TEST(SceneValidation, EveryShippedSceneStaysValidAfterReading) {
+  int scenes = 0;
+  for (const auto& entry : fs::directory_iterator(kSourceDir / "hal/sim/scenes")) {
+    if (entry.path().extension() != ".json") {
+      continue;
+    }
+    const auto scene = loadScene(entry.path());
+    ASSERT_TRUE(scene.has_value()) << scene.error().message();
+    const auto valid = config::validateScene(*scene);
+    EXPECT_TRUE(valid.has_value()) << entry.path() << ": " << valid.error().message();
+    ++scenes;
+  }
+  EXPECT_GE(scenes, 5);
+}
+
+// Given an in-memory scene with one bad value, when validated, then the error names the field as
+// the JSON would and says what parseScene() says of the same value.
+TEST(SceneValidation, InMemoryErrorsNameTheJsonField) {
+  const auto withObject = [](Object o) {
+    Scene s;
+    s.objects.push_back(std::move(o));
+    return s;
+  };
+  Object ball;
+  ball.shape = Sphere{0.0};
+  auto e = config::validateScene(withObject(ball));
+  ASSERT_FALSE(e.has_value());
+  EXPECT_EQ(e.error().field, "objects[0].shape.radius_m");
+  EXPECT_EQ(e.error().problem, "must be positive, got 0");
+  EXPECT_TRUE(e.error().file.empty());
+
+  Object checker;
+  checker.albedo.texture = CheckerTexture{0.04, {{1, 0, 0}, {0, 2, 0}}};
+  e = config::validateScene(withObject(checker));
+  ASSERT_FALSE(e.has_value());
+  EXPECT_EQ(e.error().field, "objects[0].albedo.checker.colours[1][1]");
+  EXPECT_EQ(e.error().problem, "must be between 0 and 1, got 2");
+
+  Object turning;
+  turning.motion.axis = Vec3::Zero();
+  Scene scene = withObject(turning);
+  scene.lighting.ambient = {0.1, -0.5, 0.1};  // first in file order
+  e = config::validateScene(scene);
+  ASSERT_FALSE(e.has_value());
+  EXPECT_EQ(e.error().field, "lighting.ambient[1]");
+  scene.lighting.ambient = Vec3::Zero();
+  e = config::validateScene(scene);
+  ASSERT_FALSE(e.has_value());
+  EXPECT_EQ(e.error().field, "objects[0].motion.axis");
+
+  Object mesh;
+  mesh.shape = Mesh{"meshes/cube.ply", {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 3}}};
+  e = config::validateScene(withObject(mesh));
+  ASSERT_FALSE(e.has_value());
+  EXPECT_EQ(e.error().field, "objects[0].shape.path");
+  EXPECT_EQ(e.error().problem, R"(mesh "meshes/cube.ply": triangle 0 names vertex 3 of 3)");
 }
 
 }  // namespace

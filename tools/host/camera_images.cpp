@@ -4,7 +4,7 @@
 #include <system_error>
 #include <utility>
 
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 
 namespace smx::host {
 
@@ -70,7 +70,7 @@ std::expected<void, std::string> checkHasColour(const std::filesystem::path& fil
 
 std::expected<RigAndImages, std::string> loadRigAndImages(const std::filesystem::path& rigFile,
                                                           const std::vector<std::string>& specs) {
-  auto rig = protocol::loadRig(rigFile);
+  auto rig = config::loadRig(rigFile);
   if (!rig) {
     return std::unexpected(rig.error().message());
   }

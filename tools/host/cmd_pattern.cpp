@@ -9,7 +9,7 @@
 #include "commands.hpp"
 #include "output_files.hpp"
 #include "smx/algo/pattern_image.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/sim/png_io.hpp"
 
 namespace smx::host {
@@ -21,7 +21,7 @@ struct PatternOptions {
 };
 
 int runPattern(const PatternOptions& opts, const CliStreams& io) {
-  auto rig = protocol::loadRig(opts.rig);
+  auto rig = config::loadRig(opts.rig);
   if (!rig) {
     io.err << "stripemux pattern: " << rig.error().message() << "\n";
     return kExitBadInput;

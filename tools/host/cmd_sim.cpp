@@ -13,12 +13,12 @@
 
 #include "commands.hpp"
 #include "output_files.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/renderer.hpp"
-#include "smx/sim/scene_json.hpp"
 
 namespace smx::host {
 namespace {
@@ -126,7 +126,7 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
     io.err << "stripemux sim: " << message << "\n";
     return code;
   };
-  auto rig = protocol::loadRig(opts.rig);
+  auto rig = config::loadRig(opts.rig);
   if (!rig) {
     return fail(kExitBadInput, rig.error().message());
   }
@@ -134,7 +134,7 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
   if (!scenePath) {
     return fail(kExitBadInput, scenePath.error());
   }
-  auto scene = sim::loadScene(*scenePath);
+  auto scene = config::loadScene(*scenePath);
   if (!scene) {
     return fail(kExitBadInput, scene.error().message());
   }

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "smx/config/identifier.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/hal/steady_clock.hpp"
-#include "smx/protocol/rig_json.hpp"
 
 namespace smx::host {
 
@@ -121,7 +121,7 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
   info.fps = caps->fps;
   info.compressionsMask = caps->compressionsMask;
   info.rigJson = caps->rigJson;
-  auto rig = protocol::parseRig(info.rigJson);
+  auto rig = config::parseRig(info.rigJson);
   if (!rig) {
     return Fail(where + ": the device's rig is invalid: " + rig.error().message());
   }

@@ -1,8 +1,8 @@
 // Device::create: everything the loops need, allocated once.
 #include <cmath>
 
+#include "smx/config/rig_json.hpp"
 #include "smx/device/device.hpp"
-#include "smx/protocol/rig_json.hpp"
 
 namespace smx::device {
 
@@ -11,7 +11,7 @@ using Fail = std::unexpected<std::string>;
 constexpr std::size_t kControlBytes = 4096;  // replies besides the capabilities
 }  // namespace
 
-Device::Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options)
+Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options)
     : hal_(hal),
       options_(options),
       depthUnitNm_(static_cast<std::uint32_t>(std::lround(board.config.depthUnitM * 1e9))),
@@ -26,7 +26,7 @@ Device::Device(const board::Board& board, hal::Hal hal, const DeviceOptions& opt
 
 Device::~Device() = default;
 
-std::expected<std::unique_ptr<Device>, std::string> Device::create(const board::Board& board,
+std::expected<std::unique_ptr<Device>, std::string> Device::create(const config::Board& board,
                                                                    hal::Hal hal,
                                                                    const DeviceOptions& options) {
   const algo::Rig& rig = board.rig;
@@ -77,7 +77,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const board::
     }
   }
 
-  const std::string rigJson = protocol::toJson(rig);
+  const std::string rigJson = config::toJson(rig);
   const protocol::Capabilities caps{
       .board = board.config.name,
       .firmwareVersion = options.firmwareVersion,

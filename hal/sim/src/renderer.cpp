@@ -24,6 +24,7 @@
 #include "shape_geometry.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/pattern_image.hpp"
+#include "smx/config/scene_json.hpp"
 
 // The model, its order of operations and the ground-truth definitions are in docs/simulator.md.
 namespace smx::sim {
@@ -38,7 +39,6 @@ constexpr unsigned kAllGeometry = 0xFFFFFFFFU;
 // Shadow rays start this far off the surface along its normal: 100× Embree's float rounding of
 // the origin at a few metres, far below any scene detail.
 constexpr double kShadowOffsetM = 1e-5;
-constexpr int kMaxSupersampling = 16;
 // Camera sample rays are cached per camera when the table stays below this (640×480 at 3×3
 // supersampling fits); otherwise every frame undistorts them again.
 constexpr std::size_t kMaxRayTableBytes = std::size_t{64} << 20U;
@@ -208,120 +208,6 @@ void setInstanceTransform(RTCGeometry instance, const FramePose& pose) {
   rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m.data());
 }
 
-// ---- Scene validation (create) ----
-
-bool finite(const Vec3& v) {
-  return v.allFinite();
-}
-bool positive(double x) {
-  return x > 0.0 && std::isfinite(x);
-}
-
-std::string shapeProblem(const Shape& shape) {
-  if (const auto* p = std::get_if<Plane>(&shape)) {
-    return positive(p->widthM) && positive(p->heightM) ? "" : "plane size must be positive";
-  }
-  if (const auto* b = std::get_if<Box>(&shape)) {
-    return positive(b->sizeM.x()) && positive(b->sizeM.y()) && positive(b->sizeM.z())
-               ? ""
-               : "box size must be positive";
-  }
-  if (const auto* s = std::get_if<Sphere>(&shape)) {
-    return positive(s->radiusM) ? "" : "sphere radius must be positive";
-  }
-  if (const auto* c = std::get_if<Cylinder>(&shape)) {
-    return positive(c->radiusM) && positive(c->heightM)
-               ? ""
-               : "cylinder radius and height must be positive";
-  }
-  const auto& mesh = std::get<Mesh>(shape);
-  if (mesh.triangles.empty() || mesh.vertices.empty()) {
-    return "mesh \"" + mesh.path + "\" is empty (no triangles)";
-  }
-  if (mesh.vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
-    return "mesh has too many vertices";
-  }
-  for (const auto& v : mesh.vertices) {
-    if (!v.allFinite()) {
-      return "mesh has a vertex that is not finite";
-    }
-  }
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-    for (const std::uint32_t k : mesh.triangles[i]) {
-      if (k >= mesh.vertices.size()) {
-        return "mesh triangle " + std::to_string(i) + " names vertex " + std::to_string(k) +
-               " of " + std::to_string(mesh.vertices.size());
-      }
-    }
-  }
-  return "";
-}
-
-std::string albedoProblem(const Albedo& albedo) {
-  if (!finite(albedo.rgb)) {
-    return "albedo must be finite";
-  }
-  if (const auto* c = std::get_if<CheckerTexture>(&albedo.texture)) {
-    if (!positive(c->squareM) || c->colours.empty()) {
-      return "checker texture needs a positive square size and at least one colour";
-    }
-  }
-  if (const auto* t = std::get_if<ImageTexture>(&albedo.texture)) {
-    if (t->width <= 0 || t->height <= 0 ||
-        t->texels.size() !=
-            static_cast<std::size_t>(t->width) * static_cast<std::size_t>(t->height) ||
-        !positive(t->widthM) || !positive(t->heightM)) {
-      return "image texture \"" + t->path + "\" is not loaded or has no size";
-    }
-  }
-  return "";
-}
-
-std::string objectProblem(const Object& o) {
-  if (std::string p = shapeProblem(o.shape); !p.empty()) {
-    return p;
-  }
-  const Mat3& rot = o.pose.R;
-  if (!rot.allFinite() || (rot * rot.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
-      rot.determinant() < 0.0) {
-    return "pose R is not a rotation";
-  }
-  if (!finite(o.pose.t) || !positive(o.pose.scale)) {
-    return "pose t must be finite and scale positive";
-  }
-  if (!finite(o.motion.velocityMPerFrame) || !finite(o.motion.pivot) ||
-      !std::isfinite(o.motion.angularDegPerFrame) ||
-      (o.motion.angularDegPerFrame != 0.0 && !(o.motion.axis.norm() > 0.0))) {
-    return "motion must be finite, with a non-zero axis when it turns";
-  }
-  return albedoProblem(o.albedo);
-}
-
-std::string sceneProblem(const Scene& scene) {
-  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-    if (const std::string p = objectProblem(scene.objects[i]); !p.empty()) {
-      return "objects[" + std::to_string(i) + "] (\"" + scene.objects[i].name + "\"): " + p;
-    }
-  }
-  if (scene.supersampling < 1 || scene.supersampling > kMaxSupersampling) {
-    return "supersampling must be 1 … " + std::to_string(kMaxSupersampling) + ", got " +
-           std::to_string(scene.supersampling);
-  }
-  const auto& l = scene.lighting;
-  if (!finite(l.ambient) || !std::isfinite(l.projectorPower) ||
-      !(l.projectorDefocusSigmaPx >= 0.0) || !std::isfinite(l.projectorDefocusSigmaPx) ||
-      (l.inverseSquare && !positive(l.referenceDistanceM))) {
-    return "lighting: values must be finite, defocus ≥ 0, reference distance positive";
-  }
-  const auto& c = scene.camera;
-  if (!c.crosstalk.allFinite() || !std::isfinite(c.gain) || !finite(c.noiseSigma) ||
-      (c.noiseSigma.array() < 0.0).any() || !(c.defocusSigmaPx >= 0.0) ||
-      !std::isfinite(c.defocusSigmaPx)) {
-    return "camera response: values must be finite, noise and defocus ≥ 0";
-  }
-  return "";
-}
-
 Vec3 albedoAt(const Albedo& albedo, const Vec3& local) {
   if (const auto* c = std::get_if<CheckerTexture>(&albedo.texture)) {
     const auto n = static_cast<double>(c->colours.size());
@@ -431,8 +317,9 @@ class EmbreeRenderer final : public Renderer {
 };
 
 std::expected<void, std::string> EmbreeRenderer::init() {
-  if (const std::string p = sceneProblem(scene_); !p.empty()) {
-    return std::unexpected(p);
+  // scene.json's own rules, and no others: the renderer draws every scene a file may describe.
+  if (auto valid = config::validateScene(scene_); !valid) {
+    return std::unexpected(valid.error().message());
   }
   if (auto ok = initProjectors(); !ok) {
     return ok;

@@ -6,13 +6,13 @@
 
 #include "sim_camera.hpp"
 #include "sim_trigger.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/hal/steady_clock.hpp"
 #include "smx/net/tcp_link.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/renderer.hpp"
-#include "smx/sim/scene_json.hpp"
 #include "smx/sim/sim_board.hpp"
 
 namespace smx::hal {
@@ -98,7 +98,7 @@ std::expected<std::unique_ptr<SimBoardHal>, std::string> SimBoardHal::create(
     if (!scenePath) {
       return Fail("sim.scene: " + scenePath.error());
     }
-    auto scene = sim::loadScene(*scenePath);
+    auto scene = config::loadScene(*scenePath);
     if (!scene) {
       return Fail("sim.scene: " + scene.error().message());
     }

@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
 
@@ -154,7 +154,7 @@ std::vector<LitRun> litRuns(const std::vector<Sample>& samples, unsigned allOn) 
 }
 
 TEST(GpioSimTrigger, TheBoardsLinesAreLitAroundEveryCaptureAndOnlyThen) {
-  auto board = board::loadBoard(env("SMX_BOARD"));
+  auto board = config::loadBoard(env("SMX_BOARD"));
   ASSERT_TRUE(board) << board.error().message();
   auto boardHal = hal::createBoardHal(board->config, board->rig);
   ASSERT_TRUE(boardHal) << boardHal.error();

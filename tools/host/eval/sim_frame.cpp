@@ -3,10 +3,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/config/scene_json.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/renderer.hpp"
-#include "smx/sim/scene_json.hpp"
 
 namespace smx::eval {
 
@@ -21,7 +21,7 @@ T orThrow(std::expected<T, std::string> value) {
 }  // namespace
 
 algo::Rig loadExampleRig(const std::string& file) {
-  auto rig = protocol::loadRig(orThrow(sim::dataDir()) / "boards/sim" / file);
+  auto rig = config::loadRig(orThrow(sim::dataDir()) / "boards/sim" / file);
   if (!rig) {
     throw std::runtime_error(rig.error().message());
   }
@@ -29,7 +29,7 @@ algo::Rig loadExampleRig(const std::string& file) {
 }
 
 sim::Scene loadNamedScene(const std::string& name) {
-  auto scene = sim::loadScene(orThrow(sim::sceneDir()) / (name + ".json"));
+  auto scene = config::loadScene(orThrow(sim::sceneDir()) / (name + ".json"));
   if (!scene) {
     throw std::runtime_error(scene.error().message());
   }

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "smx/algo/camera_pipeline.hpp"
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 #include "smx/device/send_queue.hpp"
 #include "smx/device/worker_pool.hpp"
 #include "smx/hal/board_hal.hpp"
@@ -53,7 +53,7 @@ class Device {
  public:
   // Init: pipelines and their arenas, the send queue, the capabilities message.
   [[nodiscard]] static std::expected<std::unique_ptr<Device>, std::string> create(
-      const board::Board& board, hal::Hal hal, const DeviceOptions& options);
+      const config::Board& board, hal::Hal hal, const DeviceOptions& options);
   ~Device();
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
@@ -85,7 +85,7 @@ class Device {
     std::unique_ptr<algo::CameraPipeline> pipeline;
   };
 
-  Device(const board::Board& board, hal::Hal hal, const DeviceOptions& options);
+  Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options);
   void decodeCamera(int camera);
   void queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs);
   void onMessage(const protocol::Message& message);

@@ -16,7 +16,7 @@
 #include "smx/config/json_text.hpp"
 
 // Typed reads of configuration values with errors that name the field, shared by the readers of
-// scene.json and board.json (rig.json predates it).
+// rig.json, board.json and scene.json.
 namespace smx::config {
 
 enum class Range : std::uint8_t { kAny, kPositive, kNonNegative, kFraction };
@@ -24,7 +24,7 @@ enum class Range : std::uint8_t { kAny, kPositive, kNonNegative, kFraction };
 // Reads values into a document whose members already hold the defaults, and keeps the first
 // problem: once one is found the remaining reads do nothing, so the reading code stays a plain
 // sequence and the report is the first problem in reading order. Readers of one document kind
-// (scene.json, board.json) derive from it for their own types.
+// (rig.json, board.json, scene.json) derive from it for their own types.
 class FieldReader {
  public:
   [[nodiscard]] bool ok() const { return !error_.has_value(); }
@@ -36,9 +36,10 @@ class FieldReader {
     }
   }
 
-  // `v` must be an object (`what`, for the message) holding only `allowed` keys.
-  bool object(const nlohmann::json& v, const std::string& path, std::string_view what,
-              Keys allowed) {
+  // `v` must be an object (`what`, for the message) holding only `allowed` keys; `hint` is said
+  // about an unknown key when no allowed key is close to it.
+  bool object(const nlohmann::json& v, const std::string& path, std::string_view what, Keys allowed,
+              std::string_view hint = {}) {
     if (!ok()) {
       return false;
     }
@@ -47,7 +48,7 @@ class FieldReader {
       return false;
     }
     if (const auto key = config::unknownKey(v, allowed)) {
-      fail(path, config::unknownKeyProblem(*key, allowed));
+      fail(path, config::unknownKeyProblem(*key, allowed, hint));
       return false;
     }
     return true;
@@ -71,6 +72,14 @@ class FieldReader {
       return std::nullopt;
     }
     const double d = v.get<double>();
+    return check(d, path, range) ? std::optional<double>(d) : std::nullopt;
+  }
+
+  // The rule of `range` for a value already read: what number() says of the same value.
+  bool check(double d, const std::string& path, Range range) {
+    if (!ok()) {
+      return false;
+    }
     const std::string got = ", got " + formatNumber(d);
     if (!std::isfinite(d)) {
       fail(path, "must be a finite number" + got);
@@ -81,9 +90,18 @@ class FieldReader {
     } else if (range == Range::kFraction && (d < 0 || d > 1)) {
       fail(path, "must be between 0 and 1" + got);
     } else {
-      return d;
+      return true;
     }
-    return std::nullopt;
+    return false;
+  }
+
+  // check() of every element, element(path, i) naming it.
+  template <class Values>
+  void checkEach(const Values& values, const std::string& path, Range range) {
+    std::size_t i = 0;
+    for (const double d : values) {
+      check(d, element(path, i++), range);
+    }
   }
 
   void number(const nlohmann::json& obj, const std::string& path, std::string_view key, Range range,
@@ -106,11 +124,17 @@ class FieldReader {
       return;
     }
     if (*d != std::floor(*d) || *d < lo || *d > hi) {
-      fail(at, "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) +
-                   " (" + std::string(what) + "), got " + formatNumber(*d));
+      fail(at, integerProblem(*d, lo, hi, what));
       return;
     }
     out = static_cast<int>(*d);
+  }
+
+  // The rule of integer() for a value already read.
+  void check(int v, const std::string& path, int lo, int hi, std::string_view what) {
+    if (v < lo || v > hi) {
+      fail(path, integerProblem(v, lo, hi, what));
+    }
   }
 
   void boolean(const nlohmann::json& obj, const std::string& path, std::string_view key,
@@ -168,6 +192,11 @@ class FieldReader {
   }
 
  private:
+  static std::string integerProblem(double v, int lo, int hi, std::string_view what) {
+    return "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + " (" +
+           std::string(what) + "), got " + formatNumber(v);
+  }
+
   std::optional<FieldError> error_;
 };
 

@@ -41,8 +41,9 @@ struct FrameRequest {
 
 class Renderer {
  public:
-  // Builds the acceleration structures for the scene; fails with a message on invalid input
-  // (empty mesh, camera index out of range is checked per frame).
+  // Builds the acceleration structures for the scene; fails with config::validateScene()'s
+  // message on a scene it refuses, and on no other scene (a camera index out of range is checked
+  // per frame).
   [[nodiscard]] static std::expected<std::unique_ptr<Renderer>, std::string> create(
       const algo::Rig& rig, const Scene& scene);
 

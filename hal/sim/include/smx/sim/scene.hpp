@@ -106,7 +106,8 @@ struct CameraResponse {
   double defocusSigmaPx = 0.0;              // Gaussian blur of the camera image, camera px
 };
 
-// The most samples per pixel side a scene asks for (64 rays per pixel: beyond that, render larger).
+// The most samples per pixel side a scene asks for (64 rays per pixel: beyond that, render larger):
+// the limit of scene.json and of config::validateScene(), which the renderer applies.
 inline constexpr int kMaxSceneSupersampling = 8;
 
 struct Scene {

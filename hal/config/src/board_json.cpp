@@ -1,4 +1,4 @@
-#include "smx/board/board_json.hpp"
+#include "smx/config/board_json.hpp"
 
 #include <arpa/inet.h>
 
@@ -14,18 +14,13 @@
 #include "smx/config/field_reader.hpp"
 #include "smx/config/identifier.hpp"
 #include "smx/config/json_reader.hpp"
-#include "smx/protocol/rig_json.hpp"
+#include "smx/config/rig_json.hpp"
 
-namespace smx::board {
+namespace smx::config {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using config::describe;
-using config::element;
-using config::jsonQuote;
-using config::member;
-using config::Range;
 
 constexpr std::array<std::string_view, 10> kTopKeys = {
     "format",  "name",     "hal",     "rig", "depth_unit_m",
@@ -39,26 +34,26 @@ constexpr std::array<std::string_view, 3> kSimKeys = {"scene", "replay", "seed"}
 constexpr std::array<std::string_view, 2> kHals = {"sim", "linux"};
 constexpr std::array<std::string_view, 3> kPixelFormats = {"RGB24", "BGR24", "YUYV"};
 
-constexpr std::array<config::FormatHint, 2> kOtherFormats = {
+constexpr std::array<FormatHint, 2> kOtherFormats = {
     {{"stripemux-rig/", " (this is a rig.json; a board names its rig in \"rig\")"},
      {"stripemux-scene/", " (this is a scene.json, not a board)"}}};
-constexpr config::DocumentSpec kBoardDocument = {.name = "board.json",
-                                                 .format = kBoardFormat,
-                                                 .topKeys = kTopKeys,
-                                                 .maxBytes = std::size_t{1} << 16U,
-                                                 .sizeNote = "",
-                                                 .nestingNeeded = 4,
-                                                 .maxNesting = 16,
-                                                 .otherFormats = kOtherFormats};
+constexpr DocumentSpec kBoardDocument = {.name = "board.json",
+                                         .format = kBoardFormat,
+                                         .topKeys = kTopKeys,
+                                         .maxBytes = std::size_t{1} << 16U,
+                                         .sizeNote = "",
+                                         .nestingNeeded = 4,
+                                         .maxNesting = 16,
+                                         .otherFormats = kOtherFormats};
 
-class Reader : public config::FieldReader {
+class Reader : public FieldReader {
  public:
   // One of `allowed` words.
   std::optional<std::string> word(const Json& obj, const std::string& path, std::string_view key,
-                                  config::Keys allowed) {
-    auto value = text(obj, path, key, "one of: " + config::joined(allowed));
+                                  Keys allowed) {
+    auto value = text(obj, path, key, "one of: " + joined(allowed));
     if (value && std::ranges::find(allowed, *value) == allowed.end()) {
-      fail(member(path, key), jsonQuote(*value) + " is not one of: " + config::joined(allowed));
+      fail(member(path, key), jsonQuote(*value) + " is not one of: " + joined(allowed));
       return std::nullopt;
     }
     return value;
@@ -234,7 +229,7 @@ void readSim(Reader& r, const Json& doc, const fs::path& dir, hal::BoardConfig& 
 }
 
 std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs::path& dir) {
-  auto parsed = config::parseDocument(text, kBoardDocument);
+  auto parsed = parseDocument(text, kBoardDocument);
   if (!parsed) {
     return std::unexpected(BoardError{{}, parsed.error().field, parsed.error().problem});
   }
@@ -245,14 +240,14 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
   board.directory = dir;
   board.name = r.text(doc, "", "name", "the board's name, e.g. \"rpi4\"").value_or("");
   // The name goes on the wire to every host and onto their terminals: an id, not free text.
-  if (auto problem = r.ok() ? config::identifierProblem(board.name) : std::nullopt) {
+  if (auto problem = r.ok() ? identifierProblem(board.name) : std::nullopt) {
     r.fail("name", std::move(*problem));
   }
   board.backend = r.word(doc, "", "hal", kHals).value_or("");
   const auto rigFile = r.text(doc, "", "rig", "the rig.json file, relative to the board folder");
   if (rigFile) {
     board.rigPath = dir / *rigFile;
-    auto rig = protocol::loadRig(board.rigPath);
+    auto rig = loadRig(board.rigPath);
     if (!rig) {
       r.fail("rig", "cannot use the rig: " + rig.error().message());
     } else {
@@ -271,17 +266,16 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
   }
   r.number(doc, "", "depth_unit_m", Range::kPositive, board.depthUnitM);
   if (r.ok() && (board.depthUnitM < 1e-6 || board.depthUnitM > 1e-2)) {
-    r.fail("depth_unit_m", "must be from 1e-06 (1 um) to 0.01 (1 cm), got " +
-                               config::formatNumber(board.depthUnitM));
+    r.fail("depth_unit_m",
+           "must be from 1e-06 (1 um) to 0.01 (1 cm), got " + formatNumber(board.depthUnitM));
   }
   if (r.ok() && board.depthUnitM < algo::minDepthUnitM(algo::kDefaultNominalDepthM)) {
-    r.fail("depth_unit_m",
-           config::formatNumber(board.depthUnitM) + " m per unit stores depths up to " +
-               config::formatNumber(algo::maxStoredDepthM(board.depthUnitM)) +
-               " m in 16 bits; the board decodes for " +
-               config::formatNumber(algo::kDefaultNominalDepthM) +
-               " m, and every depth beyond the limit would be lost; use at least " +
-               config::formatNumber(algo::minDepthUnitM(algo::kDefaultNominalDepthM)));
+    r.fail("depth_unit_m", formatNumber(board.depthUnitM) + " m per unit stores depths up to " +
+                               formatNumber(algo::maxStoredDepthM(board.depthUnitM)) +
+                               " m in 16 bits; the board decodes for " +
+                               formatNumber(algo::kDefaultNominalDepthM) +
+                               " m, and every depth beyond the limit would be lost; use at least " +
+                               formatNumber(algo::minDepthUnitM(algo::kDefaultNominalDepthM)));
   }
   if (r.ok()) {
     readCameras(r, doc, out.rig, board);
@@ -290,7 +284,7 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
     readSim(r, doc, dir, board);
   }
   if (!r.ok()) {
-    const auto e = r.firstError().value_or(config::FieldError{});
+    const auto e = r.firstError().value_or(FieldError{});
     return std::unexpected(BoardError{{}, e.field, e.problem});
   }
   return out;
@@ -299,7 +293,7 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
 }  // namespace
 
 std::string BoardError::message() const {
-  return config::errorMessage(file, field, problem);
+  return errorMessage(file, field, problem);
 }
 
 std::expected<Board, BoardError> parseBoard(std::string_view text, const fs::path& dir) {
@@ -313,9 +307,9 @@ std::expected<Board, BoardError> parseBoard(std::string_view text, const fs::pat
 std::expected<Board, BoardError> loadBoard(const fs::path& path) {
   std::error_code ec;
   const fs::path file = fs::is_directory(path, ec) ? path / "board.json" : path;
-  return config::loadDocument(file, kBoardDocument, [&](const std::string& text) {
+  return loadDocument(file, kBoardDocument, [&](const std::string& text) {
     return parseBoard(text, file.parent_path());
   });
 }
 
-}  // namespace smx::board
+}  // namespace smx::config

@@ -10,7 +10,7 @@
 
 // board.json, format `stripemux-board/1` (docs/boards.md): a board as data. Read at start-up,
 // validated completely, every failure naming the file and the field.
-namespace smx::board {
+namespace smx::config {
 
 inline constexpr std::string_view kBoardFormat = "stripemux-board/1";
 
@@ -32,4 +32,4 @@ struct Board {
 // `path` is a board folder (its board.json is read) or a board.json file.
 [[nodiscard]] std::expected<Board, BoardError> loadBoard(const std::filesystem::path& path);
 
-}  // namespace smx::board
+}  // namespace smx::config

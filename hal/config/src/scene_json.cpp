@@ -1,4 +1,4 @@
-#include "smx/sim/scene_json.hpp"
+#include "smx/config/scene_json.hpp"
 
 #include <algorithm>
 #include <array>
@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -28,16 +29,28 @@
 #include "smx/sim/mesh_io.hpp"
 #include "smx/sim/png_io.hpp"
 
-namespace smx::sim {
+namespace smx::config {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using config::describe;
-using config::element;
-using config::jsonQuote;
-using config::Keys;
-using config::member;
+using sim::Albedo;
+using sim::Box;
+using sim::CameraResponse;
+using sim::CheckerTexture;
+using sim::Cylinder;
+using sim::ImageTexture;
+using sim::Lighting;
+using sim::Mat3;
+using sim::Mesh;
+using sim::Motion;
+using sim::Object;
+using sim::Plane;
+using sim::Pose;
+using sim::Scene;
+using sim::Shape;
+using sim::Sphere;
+using sim::Vec3;
 
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
                                                       "camera_response", "objects"};
@@ -86,29 +99,26 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 10> kShapeSy
 }};
 
 // A rig.json given as the scene is named as such.
-constexpr std::array<config::FormatHint, 1> kOtherFormats = {
+constexpr std::array<FormatHint, 1> kOtherFormats = {
     {{"stripemux-rig/", " (this is a rig.json, not a scene)"}}};
 // A scene.json is a few kB and 7 levels deep (objects[i].albedo.checker.colours[j]). The bounds
 // keep a mistaken input (a mesh or an image given as the scene) from costing much.
-constexpr config::DocumentSpec kSceneDocument = {
-    .name = "scene.json",
-    .format = kSceneFormat,
-    .topKeys = kTopKeys,
-    .maxBytes = std::size_t{1} << 20U,
-    .sizeNote = " (meshes and textures go in their own files)",
-    .nestingNeeded = 7,
-    .maxNesting = 16,
-    .otherFormats = kOtherFormats};
+constexpr DocumentSpec kSceneDocument = {.name = "scene.json",
+                                         .format = kSceneFormat,
+                                         .topKeys = kTopKeys,
+                                         .maxBytes = std::size_t{1} << 20U,
+                                         .sizeNote = " (meshes and textures go in their own files)",
+                                         .nestingNeeded = 7,
+                                         .maxNesting = 16,
+                                         .otherFormats = kOtherFormats};
 
 // --- Reading scene values ---
 
-using config::Range;
-
 // The generic reads, plus the scene's vectors and matrices (Eigen).
-class Reader : public config::FieldReader {
+class Reader : public FieldReader {
  public:
   [[nodiscard]] std::unexpected<SceneError> error() const {
-    const auto e = firstError().value_or(config::FieldError{});
+    const auto e = firstError().value_or(FieldError{});
     return std::unexpected(SceneError{{}, e.field, e.problem});
   }
 
@@ -166,25 +176,17 @@ Mat3 rotationFromDegrees(const Vec3& deg) {
   return rz * ry * rx;
 }
 
-void checkRotation(Reader& r, const Mat3& rotation, const std::string& path) {
-  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rowMajor = rotation;
-  if (auto problem = config::rotationProblem(std::span<const double, 9>(rowMajor.data(), 9))) {
-    r.fail(path, std::move(*problem));
-  }
-}
-
 void readLighting(Reader& r, const Json& doc, Lighting& out) {
   const std::string path = "lighting";
   const Json* v = r.find(doc, path);
   if (v == nullptr || !r.object(*v, path, "the lighting settings", kLightingKeys)) {
     return;
   }
-  r.vec3(*v, path, "ambient", "r, g, b, each 0 to 1", Range::kFraction, out.ambient);
-  r.number(*v, path, "projector_power", Range::kPositive, out.projectorPower);
+  r.vec3(*v, path, "ambient", "r, g, b, each 0 to 1", Range::kAny, out.ambient);
+  r.number(*v, path, "projector_power", Range::kAny, out.projectorPower);
   r.boolean(*v, path, "inverse_square", out.inverseSquare);
-  r.number(*v, path, "reference_distance_m", Range::kPositive, out.referenceDistanceM);
-  r.number(*v, path, "projector_defocus_sigma_px", Range::kNonNegative,
-           out.projectorDefocusSigmaPx);
+  r.number(*v, path, "reference_distance_m", Range::kAny, out.referenceDistanceM);
+  r.number(*v, path, "projector_defocus_sigma_px", Range::kAny, out.projectorDefocusSigmaPx);
 }
 
 void readCameraResponse(Reader& r, const Json& doc, CameraResponse& out) {
@@ -195,9 +197,9 @@ void readCameraResponse(Reader& r, const Json& doc, CameraResponse& out) {
   }
   r.mat3(*v, path, "crosstalk", "row-major 3x3 matrix, camera RGB = crosstalk * scene RGB",
          out.crosstalk);
-  r.number(*v, path, "gain", Range::kPositive, out.gain);
-  r.vec3(*v, path, "noise_sigma", "r, g, b in grey levels", Range::kNonNegative, out.noiseSigma);
-  r.number(*v, path, "defocus_sigma_px", Range::kNonNegative, out.defocusSigmaPx);
+  r.number(*v, path, "gain", Range::kAny, out.gain);
+  r.vec3(*v, path, "noise_sigma", "r, g, b in grey levels", Range::kAny, out.noiseSigma);
+  r.number(*v, path, "defocus_sigma_px", Range::kAny, out.defocusSigmaPx);
 }
 
 std::string shapeTypeNames() {
@@ -245,7 +247,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
   }
   std::string_view guess;
   for (const auto& [word, type] : kShapeSynonyms) {
-    if (config::equalIgnoringCase(word, name)) {
+    if (equalIgnoringCase(word, name)) {
       guess = type;
     }
   }
@@ -253,7 +255,7 @@ const ShapeType* readShapeType(Reader& r, const Json& shape, const std::string& 
     std::array<std::string_view, kShapeTypes.size()> names{};
     std::transform(kShapeTypes.begin(), kShapeTypes.end(), names.begin(),
                    [](const ShapeType& t) { return t.name; });
-    guess = config::closestWord(name, names);
+    guess = closestWord(name, names);
   }
   r.fail(at, "unknown shape type " + jsonQuote(name) +
                  (guess.empty() ? "" : " (did you mean " + jsonQuote(guess) + "?)") +
@@ -277,28 +279,28 @@ void readShape(Reader& r, const Json& obj, const std::string& objectPath, Shape&
   if (type == nullptr) {
     return;
   }
-  if (const auto key = config::unknownKey(*v, type->keys)) {
-    r.fail(path, config::unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
+  if (const auto key = unknownKey(*v, type->keys)) {
+    r.fail(path, unknownKeyProblem(*key, type->keys, otherShapeHint(*key, type->name)));
     return;
   }
   if (type->name == "plane") {
     Plane plane;
-    r.number(*v, path, "width_m", Range::kPositive, plane.widthM);
-    r.number(*v, path, "height_m", Range::kPositive, plane.heightM);
+    r.number(*v, path, "width_m", Range::kAny, plane.widthM);
+    r.number(*v, path, "height_m", Range::kAny, plane.heightM);
     out = plane;
   } else if (type->name == "box") {
     Box box;
-    r.vec3(*v, path, "size_m", "x, y, z edge lengths in metres, each positive", Range::kPositive,
+    r.vec3(*v, path, "size_m", "x, y, z edge lengths in metres, each positive", Range::kAny,
            box.sizeM);
     out = box;
   } else if (type->name == "sphere") {
     Sphere sphere;
-    r.number(*v, path, "radius_m", Range::kPositive, sphere.radiusM);
+    r.number(*v, path, "radius_m", Range::kAny, sphere.radiusM);
     out = sphere;
   } else if (type->name == "cylinder") {
     Cylinder cylinder;
-    r.number(*v, path, "radius_m", Range::kPositive, cylinder.radiusM);
-    r.number(*v, path, "height_m", Range::kPositive, cylinder.heightM);
+    r.number(*v, path, "radius_m", Range::kAny, cylinder.radiusM);
+    r.number(*v, path, "height_m", Range::kAny, cylinder.heightM);
     r.boolean(*v, path, "capped", cylinder.capped);
     out = cylinder;
   } else {
@@ -327,11 +329,8 @@ void readPose(Reader& r, const Json& obj, const std::string& objectPath, Pose& o
     out.R = rotationFromDegrees(degrees);
   } else if (v->contains("R")) {
     r.mat3(*v, path, "R", "row-major 3x3 rotation, object to world", out.R);
-    if (r.ok()) {
-      checkRotation(r, out.R, member(path, "R"));
-    }
   }
-  r.number(*v, path, "scale", Range::kPositive, out.scale);
+  r.number(*v, path, "scale", Range::kAny, out.scale);
 }
 
 void readMotion(Reader& r, const Json& obj, const std::string& objectPath, Motion& out) {
@@ -343,17 +342,6 @@ void readMotion(Reader& r, const Json& obj, const std::string& objectPath, Motio
   r.vec3(*v, path, "velocity_m_per_frame", "x, y, z in metres per frame", Range::kAny,
          out.velocityMPerFrame);
   r.vec3(*v, path, "axis", "x, y, z direction of the rotation axis", Range::kAny, out.axis);
-  if (r.ok()) {
-    // stableNorm: [1e300, 0, 0] is a fine direction even though its squared norm overflows.
-    const double norm = out.axis.stableNorm();
-    if (!(norm > 0)) {
-      r.fail(member(path, "axis"),
-             "must not be the zero vector; it is the direction of the rotation axis, e.g. [0, 1, "
-             "0]");
-      return;
-    }
-    out.axis /= norm;
-  }
   r.number(*v, path, "angular_deg_per_frame", Range::kAny, out.angularDegPerFrame);
   r.vec3(*v, path, "pivot", "x, y, z of a point on the axis, metres", Range::kAny, out.pivot);
 }
@@ -362,7 +350,7 @@ void readChecker(Reader& r, const Json& v, const std::string& path, CheckerTextu
   if (!r.object(v, path, R"(a checkerboard {"square_m", "colours"})", kCheckerKeys)) {
     return;
   }
-  r.number(v, path, "square_m", Range::kPositive, out.squareM);
+  r.number(v, path, "square_m", Range::kAny, out.squareM);
   const Json* colours = r.find(v, "colours");
   if (colours == nullptr) {
     return;
@@ -375,7 +363,7 @@ void readChecker(Reader& r, const Json& v, const std::string& path, CheckerTextu
   out.colours.clear();
   for (std::size_t i = 0; i < colours->size(); ++i) {
     const auto rgb =
-        r.numbers<3>((*colours)[i], element(at, i), "r, g, b, each 0 to 1", Range::kFraction);
+        r.numbers<3>((*colours)[i], element(at, i), "r, g, b, each 0 to 1", Range::kAny);
     if (!rgb) {
       return;
     }
@@ -389,8 +377,8 @@ void readTexture(Reader& r, const Json& v, const std::string& path, ImageTexture
   }
   out.path =
       r.text(v, path, "path", "the PNG file, e.g. \"textures/poster.png\"").value_or(std::string());
-  r.number(v, path, "width_m", Range::kPositive, out.widthM);
-  r.number(v, path, "height_m", Range::kPositive, out.heightM);
+  r.number(v, path, "width_m", Range::kAny, out.widthM);
+  r.number(v, path, "height_m", Range::kAny, out.heightM);
 }
 
 void readAlbedo(Reader& r, const Json& obj, const std::string& objectPath, Albedo& out) {
@@ -414,7 +402,7 @@ void readAlbedo(Reader& r, const Json& obj, const std::string& objectPath, Albed
     return;
   }
   if (given[0] == "rgb") {
-    r.vec3(*v, path, "rgb", "r, g, b, each 0 to 1", Range::kFraction, out.rgb);
+    r.vec3(*v, path, "rgb", "r, g, b, each 0 to 1", Range::kAny, out.rgb);
   } else if (given[0] == "checker") {
     CheckerTexture checker;
     readChecker(r, v->at("checker"), member(path, "checker"), checker);
@@ -423,6 +411,140 @@ void readAlbedo(Reader& r, const Json& obj, const std::string& objectPath, Albed
     ImageTexture texture;
     readTexture(r, v->at("texture"), member(path, "texture"), texture);
     out.texture = std::move(texture);
+  }
+}
+
+// --- value rules, shared by parseScene() and validateScene() ---
+//
+// The reading above checks types and array lengths; these rules check values, once per part,
+// right after the part is read, so that a problem is still reported in file order (within a
+// part, types first). A scene built in memory passes through the same rules.
+
+void checkSupersampling(Reader& r, int supersampling) {
+  r.check(supersampling, "supersampling", 1, sim::kMaxSceneSupersampling, "samples per pixel side");
+}
+
+void checkLighting(Reader& r, const Lighting& l) {
+  const std::string path = "lighting";
+  r.checkEach(l.ambient, member(path, "ambient"), Range::kFraction);
+  r.check(l.projectorPower, member(path, "projector_power"), Range::kPositive);
+  r.check(l.referenceDistanceM, member(path, "reference_distance_m"), Range::kPositive);
+  r.check(l.projectorDefocusSigmaPx, member(path, "projector_defocus_sigma_px"),
+          Range::kNonNegative);
+}
+
+void checkCameraResponse(Reader& r, const CameraResponse& c) {
+  const std::string path = "camera_response";
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> crosstalk = c.crosstalk;
+  r.checkEach(std::span<const double>(crosstalk.data(), 9), member(path, "crosstalk"), Range::kAny);
+  r.check(c.gain, member(path, "gain"), Range::kPositive);
+  r.checkEach(c.noiseSigma, member(path, "noise_sigma"), Range::kNonNegative);
+  r.check(c.defocusSigmaPx, member(path, "defocus_sigma_px"), Range::kNonNegative);
+}
+
+void checkShape(Reader& r, const Shape& shape, const std::string& path) {
+  if (const auto* p = std::get_if<Plane>(&shape)) {
+    r.check(p->widthM, member(path, "width_m"), Range::kPositive);
+    r.check(p->heightM, member(path, "height_m"), Range::kPositive);
+  } else if (const auto* b = std::get_if<Box>(&shape)) {
+    r.checkEach(b->sizeM, member(path, "size_m"), Range::kPositive);
+  } else if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    r.check(sphere->radiusM, member(path, "radius_m"), Range::kPositive);
+  } else if (const auto* c = std::get_if<Cylinder>(&shape)) {
+    r.check(c->radiusM, member(path, "radius_m"), Range::kPositive);
+    r.check(c->heightM, member(path, "height_m"), Range::kPositive);
+  } else if (std::get<Mesh>(shape).path.empty()) {
+    r.fail(member(path, "path"), "must not be empty");
+  }
+}
+
+void checkPose(Reader& r, const Pose& pose, const std::string& path) {
+  r.checkEach(pose.t, member(path, "t"), Range::kAny);
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation = pose.R;
+  r.checkEach(std::span<const double>(rotation.data(), 9), member(path, "R"), Range::kAny);
+  if (auto problem =
+          r.ok() ? rotationProblem(std::span<const double, 9>(rotation.data(), 9)) : std::nullopt) {
+    r.fail(member(path, "R"), std::move(*problem));
+  }
+  r.check(pose.scale, member(path, "scale"), Range::kPositive);
+}
+
+void checkMotion(Reader& r, const Motion& m, const std::string& path) {
+  r.checkEach(m.velocityMPerFrame, member(path, "velocity_m_per_frame"), Range::kAny);
+  r.checkEach(m.axis, member(path, "axis"), Range::kAny);
+  // stableNorm: [1e300, 0, 0] is a fine direction even though its squared norm overflows.
+  if (r.ok() && !(m.axis.stableNorm() > 0)) {
+    r.fail(member(path, "axis"),
+           "must not be the zero vector; it is the direction of the rotation axis, e.g. [0, 1, 0]");
+  }
+  r.check(m.angularDegPerFrame, member(path, "angular_deg_per_frame"), Range::kAny);
+  r.checkEach(m.pivot, member(path, "pivot"), Range::kAny);
+}
+
+void checkAlbedo(Reader& r, const Albedo& a, const std::string& path) {
+  if (const auto* c = std::get_if<CheckerTexture>(&a.texture)) {
+    const std::string at = member(path, "checker");
+    r.check(c->squareM, member(at, "square_m"), Range::kPositive);
+    if (r.ok() && c->colours.empty()) {
+      r.fail(member(at, "colours"), "must be an array of at least one [r, g, b] colour, got []");
+    }
+    for (std::size_t i = 0; i < c->colours.size(); ++i) {
+      r.checkEach(c->colours[i], element(member(at, "colours"), i), Range::kFraction);
+    }
+  } else if (const auto* t = std::get_if<ImageTexture>(&a.texture)) {
+    const std::string at = member(path, "texture");
+    if (r.ok() && t->path.empty()) {
+      r.fail(member(at, "path"), "must not be empty");
+    }
+    r.check(t->widthM, member(at, "width_m"), Range::kPositive);
+    r.check(t->heightM, member(at, "height_m"), Range::kPositive);
+  } else {
+    r.checkEach(a.rgb, member(path, "rgb"), Range::kFraction);
+  }
+}
+
+// An object's values, in the order its parts are read.
+void checkObject(Reader& r, const Object& o, const std::string& path) {
+  checkShape(r, o.shape, member(path, "shape"));
+  checkPose(r, o.pose, member(path, "pose"));
+  checkMotion(r, o.motion, member(path, "motion"));
+  checkAlbedo(r, o.albedo, member(path, "albedo"));
+}
+
+// What the object's files hold (the loaders promise it; a scene built in memory may not).
+void checkLoaded(Reader& r, const Object& o, const std::string& path) {
+  if (const auto* mesh = std::get_if<Mesh>(&o.shape); mesh != nullptr && r.ok()) {
+    const std::string at = member(member(path, "shape"), "path");
+    const std::string name = "mesh " + jsonQuote(mesh->path);
+    if (mesh->triangles.empty() || mesh->vertices.empty()) {
+      r.fail(at, name + " is empty (no triangles)");
+    } else if (mesh->vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
+      r.fail(at, name + " has more vertices than 32-bit indices can name");
+    } else if (!std::ranges::all_of(mesh->vertices, [](const auto& v) { return v.allFinite(); })) {
+      r.fail(at, name + " has a vertex that is not finite");
+    }
+    for (std::size_t i = 0; i < mesh->triangles.size() && r.ok(); ++i) {
+      for (const std::uint32_t k : mesh->triangles[i]) {
+        if (k >= mesh->vertices.size()) {
+          r.fail(at, name + ": triangle " + std::to_string(i) + " names vertex " +
+                         std::to_string(k) + " of " + std::to_string(mesh->vertices.size()));
+        }
+      }
+    }
+  }
+  if (const auto* t = std::get_if<ImageTexture>(&o.albedo.texture); t != nullptr && r.ok()) {
+    if (t->width <= 0 || t->height <= 0 ||
+        t->texels.size() !=
+            static_cast<std::size_t>(t->width) * static_cast<std::size_t>(t->height)) {
+      r.fail(member(member(member(path, "albedo"), "texture"), "path"),
+             "texture " + jsonQuote(t->path) + " is not loaded (no texels)");
+    }
+  }
+}
+
+void checkObjectCount(Reader& r, std::size_t n) {
+  if (n == 0) {
+    r.fail("objects", "at least one object is required, got none");
   }
 }
 
@@ -477,7 +599,7 @@ class FileLoader {
     const fs::path file = resolve(mesh.path);
     auto it = meshes_.find(file);
     if (it == meshes_.end()) {
-      auto loaded = loadMesh(file);
+      auto loaded = sim::loadMesh(file);
       if (!loaded) {
         r.fail(field, "cannot load mesh " + loaded.error().message());
         return;
@@ -496,7 +618,7 @@ class FileLoader {
                         (ec ? ec.message() : std::string("no such file")));
       return;
     }
-    const auto image = readPngRgb8(file);
+    const auto image = sim::readPngRgb8(file);
     if (!image) {
       r.fail(field, "cannot load texture " + image.error());
       return;
@@ -536,10 +658,24 @@ void readObject(Reader& r, const Json& v, std::size_t index, NameRegistry& names
     names.add(r, object.name, path, false);
   }
   readShape(r, v, path, object.shape);
+  if (r.ok()) {
+    checkShape(r, object.shape, member(path, "shape"));
+  }
   readPose(r, v, path, object.pose);
+  if (r.ok()) {
+    checkPose(r, object.pose, member(path, "pose"));
+  }
   readMotion(r, v, path, object.motion);
+  if (r.ok()) {
+    checkMotion(r, object.motion, member(path, "motion"));
+    object.motion.axis /= object.motion.axis.stableNorm();
+  }
   readAlbedo(r, v, path, object.albedo);
+  if (r.ok()) {
+    checkAlbedo(r, object.albedo, member(path, "albedo"));
+  }
   files.load(r, path, object);
+  checkLoaded(r, object, path);
   scene.objects.push_back(std::move(object));
 }
 
@@ -555,10 +691,7 @@ void readObjects(Reader& r, const Json& doc, const fs::path& baseDir, Scene& sce
     r.fail("objects", "must be an array of objects, got " + describe(*it));
     return;
   }
-  if (it->empty()) {
-    r.fail("objects", "at least one object is required, got none");
-    return;
-  }
+  checkObjectCount(r, it->size());
   NameRegistry names;
   FileLoader files(baseDir);
   for (std::size_t i = 0; i < it->size() && r.ok(); ++i) {
@@ -567,7 +700,7 @@ void readObjects(Reader& r, const Json& doc, const fs::path& baseDir, Scene& sce
 }
 
 std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs::path& baseDir) {
-  auto parsed = config::parseDocument(text, kSceneDocument);
+  auto parsed = parseDocument(text, kSceneDocument);
   if (!parsed) {
     auto& e = parsed.error();
     return std::unexpected(SceneError{{}, std::move(e.field), std::move(e.problem)});
@@ -575,10 +708,12 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   const Json& doc = *parsed;
   Reader r;
   Scene scene;
-  r.integer(doc, "", "supersampling", 1, kMaxSceneSupersampling, "samples per pixel side",
+  r.integer(doc, "", "supersampling", 1, sim::kMaxSceneSupersampling, "samples per pixel side",
             scene.supersampling);
   readLighting(r, doc, scene.lighting);
+  checkLighting(r, scene.lighting);
   readCameraResponse(r, doc, scene.camera);
+  checkCameraResponse(r, scene.camera);
   readObjects(r, doc, baseDir, scene);
   if (!r.ok()) {
     return r.error();
@@ -589,7 +724,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
 }  // namespace
 
 std::string SceneError::message() const {
-  return config::errorMessage(file, field, problem);
+  return errorMessage(file, field, problem);
 }
 
 std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
@@ -602,10 +737,30 @@ std::expected<Scene, SceneError> parseScene(std::string_view jsonText,
   }
 }
 
+std::expected<void, SceneError> validateScene(const Scene& scene) {
+  try {
+    Reader r;
+    checkSupersampling(r, scene.supersampling);
+    checkLighting(r, scene.lighting);
+    checkCameraResponse(r, scene.camera);
+    checkObjectCount(r, scene.objects.size());
+    for (std::size_t i = 0; i < scene.objects.size() && r.ok(); ++i) {
+      checkObject(r, scene.objects[i], element("objects", i));
+      checkLoaded(r, scene.objects[i], element("objects", i));
+    }
+    if (!r.ok()) {
+      return r.error();
+    }
+    return {};
+  } catch (const std::exception& e) {
+    return std::unexpected(SceneError{{}, {}, std::string("cannot check the scene: ") + e.what()});
+  }
+}
+
 std::expected<Scene, SceneError> loadScene(const std::filesystem::path& file) {
-  return config::loadDocument(file, kSceneDocument, [&](const std::string& text) {
+  return loadDocument(file, kSceneDocument, [&](const std::string& text) {
     return parseScene(text, file.parent_path());
   });
 }
 
-}  // namespace smx::sim
+}  // namespace smx::config

@@ -11,7 +11,7 @@
 //
 // Init-time code: allocates, uses double. parseRig(), loadRig() and validateRig() never throw
 // (even on out-of-memory); every failure is a RigError naming the offending field.
-namespace smx::protocol {
+namespace smx::config {
 
 // The `format` value this build reads and writes.
 inline constexpr std::string_view kRigFormat = "stripemux-rig/1";
@@ -43,4 +43,4 @@ struct RigError {
 // written as null (JSON has no NaN or infinity), which parseRig() rejects.
 [[nodiscard]] std::string toJson(const algo::Rig& rig);
 
-}  // namespace smx::protocol
+}  // namespace smx::config
