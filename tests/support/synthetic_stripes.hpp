@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "smx/algo/image_view.hpp"
@@ -54,6 +55,26 @@ inline std::vector<algo::Rgb8> superpose(const std::vector<SyntheticPattern>& pa
     }
   }
   return image;
+}
+
+// The image seen on a surface whose colour varies (a fade across x in red, across y in green),
+// with Gaussian noise of σ 8 grey levels: the strength plateaus, contrast floors and colour
+// divisors of the demultiplexer then take many values.
+inline void colourAndNoise(std::vector<algo::Rgb8>& image, int w, int h, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 8.0);
+  const auto channel = [&](std::uint8_t v, double gain) {
+    const double out = v * gain + noise(rng);
+    return static_cast<std::uint8_t>(out < 0 ? 0 : (out > 255 ? 255 : out + 0.5));
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      algo::Rgb8& px = image[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
+                             static_cast<std::size_t>(x)];
+      const double fade = 0.55 + 0.45 * x / w;
+      px = {channel(px.r, fade), channel(px.g, 1.0 - 0.3 * y / h), channel(px.b, 0.8)};
+    }
+  }
 }
 
 }  // namespace smx::test

@@ -7,7 +7,6 @@
 
 #include <cstddef>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -48,19 +47,7 @@ bool sameRows(ImageView<const T> a, ImageView<const T> b) {
 // that the strength plateaus, contrast floors and colour divisors all take many values.
 std::vector<Rgb8> noisyFrame(const std::vector<SyntheticPattern>& patterns, int w, int h) {
   std::vector<Rgb8> image = test::superpose(patterns, w, h);
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 8.0);
-  const auto channel = [&](std::uint8_t v, double gain) {
-    const double out = v * gain + noise(rng);
-    return static_cast<std::uint8_t>(out < 0 ? 0 : (out > 255 ? 255 : out + 0.5));
-  };
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      Rgb8& px = image[static_cast<std::size_t>(y * w + x)];
-      const double fade = 0.55 + 0.45 * x / w;
-      px = {channel(px.r, fade), channel(px.g, 1.0 - 0.3 * y / h), channel(px.b, 0.8)};
-    }
-  }
+  test::colourAndNoise(image, w, h, 7);
   return image;
 }
 

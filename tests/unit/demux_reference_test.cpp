@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -88,19 +87,7 @@ std::vector<Rgb8> noisyImage(const std::vector<SyntheticPattern>& patterns, int 
       }
     }
   }
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, 8.0);
-  const auto channel = [&](std::uint8_t v, double gain) {
-    const double out = v * gain + noise(rng);
-    return static_cast<std::uint8_t>(out < 0 ? 0 : (out > 255 ? 255 : out + 0.5));
-  };
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      Rgb8& px = image[static_cast<std::size_t>(y * w + x)];
-      const double fade = 0.55 + 0.45 * x / w;
-      px = {channel(px.r, fade), channel(px.g, 1.0 - 0.3 * y / h), channel(px.b, 0.8)};
-    }
-  }
+  test::colourAndNoise(image, w, h, seed);
   return image;
 }
 

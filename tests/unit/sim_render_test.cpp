@@ -1086,7 +1086,8 @@ TEST(RenderSceneRules, RendererRefusesExactlyWhatTheValidatorRefuses) {
       {"supersampling 0", [](Scene& s) { s.supersampling = 0; }, false},
       {"limit + 1", [](Scene& s) { s.supersampling = kMaxSceneSupersampling + 1; }, false},
       {"ambient 1", [](Scene& s) { s.lighting.ambient = Vec3::Ones(); }, true},
-      {"ambient above 1", [](Scene& s) { s.lighting.ambient.y() = 1.5; }, false},
+      {"ambient above 1 (saturating)", [](Scene& s) { s.lighting.ambient.y() = 1.5; }, true},
+      {"ambient negative", [](Scene& s) { s.lighting.ambient.y() = -0.5; }, false},
       {"no inverse square, distance 0",
        [](Scene& s) {
          s.lighting.inverseSquare = false;

@@ -646,8 +646,8 @@ TEST(SceneJsonErrors, SigmasMustNotBeNegative) {
 
 TEST(SceneJsonErrors, ColoursAreFractions) {
   expectRejected(
-      validSceneWith("\"ambient\": [0.01, 0.02, 0.04]", "\"ambient\": [0.01, 0.02, 1.5]"),
-      "lighting.ambient[2]", {"must be between 0 and 1, got 1.5"});
+      validSceneWith("\"ambient\": [0.01, 0.02, 0.04]", "\"ambient\": [0.01, 0.02, -0.5]"),
+      "lighting.ambient[2]", {"must not be negative, got -0.5"});
   expectRejected(validSceneWith("\"rgb\": [0.2, 0.4, 0.6]", "\"rgb\": [-0.1, 0.4, 0.6]"),
                  "objects[1].albedo.rgb[0]", {"must be between 0 and 1, got -0.1"});
   expectRejected(validSceneWith("[0, 0.5, 1]]", "[0, 0.5, 2]]"),

@@ -182,7 +182,7 @@ void readLighting(Reader& r, const Json& doc, Lighting& out) {
   if (v == nullptr || !r.object(*v, path, "the lighting settings", kLightingKeys)) {
     return;
   }
-  r.vec3(*v, path, "ambient", "r, g, b, each 0 to 1", Range::kAny, out.ambient);
+  r.vec3(*v, path, "ambient", "r, g, b, each at least 0", Range::kAny, out.ambient);
   r.number(*v, path, "projector_power", Range::kAny, out.projectorPower);
   r.boolean(*v, path, "inverse_square", out.inverseSquare);
   r.number(*v, path, "reference_distance_m", Range::kAny, out.referenceDistanceM);
@@ -426,7 +426,8 @@ void checkSupersampling(Reader& r, int supersampling) {
 
 void checkLighting(Reader& r, const Lighting& l) {
   const std::string path = "lighting";
-  r.checkEach(l.ambient, member(path, "ambient"), Range::kFraction);
+  // Above 1 the ambient alone saturates the camera: sunlight on a scanner, which the eval sweeps.
+  r.checkEach(l.ambient, member(path, "ambient"), Range::kNonNegative);
   r.check(l.projectorPower, member(path, "projector_power"), Range::kPositive);
   r.check(l.referenceDistanceM, member(path, "reference_distance_m"), Range::kPositive);
   r.check(l.projectorDefocusSigmaPx, member(path, "projector_defocus_sigma_px"),
