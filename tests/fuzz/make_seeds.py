@@ -56,6 +56,9 @@ def png_seeds():
     whole = png(4, 3, 2, 8, rgb)
     write("png", "truncated.png", whole[:-20])
     write("png", "bad_crc.png", whole[:29] + b"\0\0\0\0" + whole[33:])
+    # What png_fuzz found: a zTXt chunk claiming 738 MB, the file ending inside its frame.
+    header = png(3, 2, 0, 16, [])[:33]
+    write("png", "ztxt_cut_in_frame.png", header + struct.pack(">I", 738197525) + b"zTXtc")
 
 
 def json_seeds():

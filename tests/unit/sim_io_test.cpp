@@ -237,6 +237,24 @@ TEST(SimIo, PngChunkClaimingMoreThanTheFileHasIsRefusedUnallocated) {
       << rgb.error();
 }
 
+// Given the 42 bytes png_fuzz found (a 3x2 IHDR, then a "zTXt" chunk claiming 738197525 bytes,
+// the file ending before the chunk's CRC), when read, then the chunk is refused by name before
+// anything near its claim is allocated.
+TEST(SimIo, PngChunkCutInsideItsFrameIsRefusedUnallocated) {
+  const std::vector<std::uint8_t> found = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48,
+      0x44, 0x52, 0x00, 0x00, 0x00, 0x03, 0x00, 0x00, 0x00, 0x02, 0x10, 0x00, 0x00, 0x00,
+      0x00, 0xe8, 0x8f, 0xe5, 0x85, 0x2c, 0x00, 0x00, 0x15, 0x7a, 0x54, 0x58, 0x74, 0x63};
+  const test::AllocationCounter counter;
+  const auto grey = readPngGray16(std::as_bytes(std::span(found)), "found.png");
+  EXPECT_LT(counter.bytes(), 1U << 20U);
+  ASSERT_FALSE(grey.has_value());
+  EXPECT_NE(grey.error().find("found.png: chunk \"zTXt\" claims 738197525 bytes, but the file "
+                              "has 0 left"),
+            std::string::npos)
+      << grey.error();
+}
+
 // Given a caller that knows the size (a 640x480 camera), when a PNG claims another, then the
 // error names the claim and the camera's size, and an expected size beyond the maxima is refused;
 // the in-memory reader, which the file reader uses, gives the same answers; sizes at the limits

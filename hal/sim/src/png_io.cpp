@@ -76,18 +76,21 @@ std::uint64_t bigEndian32(std::span<const std::byte> bytes) {
 }
 
 // Each chunk's length against the bytes the file has left. libpng allocates what an ancillary
-// chunk (sPLT) claims before it reads the data, so a chunk of 45 bytes could cost 2 GB. Bytes that
-// are not a PNG, or cut inside a chunk's frame, are left to libpng to name.
+// chunk (sPLT, zTXt) claims before it reads the data, so a chunk of 45 bytes could cost 2 GB,
+// also when the file ends inside the chunk's CRC. Bytes that are not a PNG, or that end before a
+// chunk's length and type, are left to libpng to name.
 std::expected<void, std::string> checkChunkLengths(std::span<const std::byte> bytes,
                                                    std::string_view name) {
   constexpr std::size_t kSignature = 8;
+  constexpr std::size_t kLengthAndType = 8;
   constexpr std::size_t kChunkFrame = 12;  // length, type, CRC
   if (bytes.size() < kSignature ||
       png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, kSignature) != 0) {
     return {};
   }
-  for (std::size_t at = kSignature; bytes.size() - at >= kChunkFrame;) {
-    const std::size_t left = bytes.size() - at - kChunkFrame;
+  for (std::size_t at = kSignature; bytes.size() - at >= kLengthAndType;) {
+    const std::size_t rest = bytes.size() - at;
+    const std::size_t left = rest >= kChunkFrame ? rest - kChunkFrame : 0;
     const std::uint64_t length = bigEndian32(bytes.subspan(at));
     const std::string type(reinterpret_cast<const char*>(bytes.data() + at + 4), 4);
     if (length > left) {
