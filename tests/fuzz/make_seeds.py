@@ -59,6 +59,7 @@ def png_seeds():
     # What png_fuzz found: a zTXt chunk claiming 738 MB, the file ending inside its frame.
     header = png(3, 2, 0, 16, [])[:33]
     write("png", "ztxt_cut_in_frame.png", header + struct.pack(">I", 738197525) + b"zTXtc")
+    write("png", "empty_chunk_cut_in_frame.png", header + b"\0\0\0\0IDAT\0")
 
 
 def json_seeds():

@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -253,6 +255,23 @@ TEST(SimIo, PngChunkCutInsideItsFrameIsRefusedUnallocated) {
                               "has 0 left"),
             std::string::npos)
       << grey.error();
+}
+
+// Given PNGs whose last chunk frame is cut after its length and type (an empty chunk without its
+// CRC, as png_fuzz found), when read, then each is refused with libpng's reason and nothing is
+// read past the bytes (the host-asan tier runs this under AddressSanitizer).
+TEST(SimIo, PngEndingInsideAnEmptyChunksFrameIsRefusedWithoutReadingPastIt) {
+  const auto whole = test::pngClaiming(3, 2);
+  for (std::size_t cut = 8; cut < 12; ++cut) {
+    std::vector<std::byte> bytes(whole.begin(), whole.begin() + 33);  // signature and IHDR
+    const std::array<std::uint8_t, 11> emptyChunk = {0, 0, 0, 0, 'I', 'D', 'A', 'T', 0, 0, 0};
+    for (std::size_t i = 0; i < cut; ++i) {
+      bytes.push_back(static_cast<std::byte>(emptyChunk[i]));
+    }
+    const auto rgb = readPngRgb8(std::span<const std::byte>(bytes), "cut.png");
+    ASSERT_FALSE(rgb.has_value()) << cut;
+    EXPECT_EQ(rgb.error().rfind("cut.png: ", 0), 0U) << rgb.error();
+  }
 }
 
 // Given a caller that knows the size (a 640x480 camera), when a PNG claims another, then the

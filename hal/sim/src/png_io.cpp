@@ -98,7 +98,7 @@ std::expected<void, std::string> checkChunkLengths(std::span<const std::byte> by
                              std::to_string(length) + " bytes, but the file has " +
                              std::to_string(left) + " left");
     }
-    if (type == "IEND") {
+    if (type == "IEND" || rest < kChunkFrame) {
       break;
     }
     at += kChunkFrame + static_cast<std::size_t>(length);
