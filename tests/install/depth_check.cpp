@@ -2,10 +2,12 @@
 // the simulator's depth truth. Passes (exit 0) when at least MIN_COMPLETENESS of the truth's
 // surface pixels have depth and 95 % of those are within 3 mm; prints both shares either way.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
+#include <vector>
 
+#include "smx/eval/depth_eval.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
 
@@ -27,23 +29,18 @@ int main(int argc, char** argv) {
   }
   const double unitM = std::stod(argv[3]);
   const double minCompleteness = std::stod(argv[4]);
-  int surface = 0;
-  int valid = 0;
+  const auto truthView =
+      *smx::algo::ImageView<const float>::packed(truth->values, truth->width, truth->height);
+  const std::vector<std::uint8_t> everywhere(depth->pixels.size(), 1);
+  const auto region =
+      *smx::algo::ImageView<const std::uint8_t>::packed(everywhere, depth->width, depth->height);
+  const auto score = smx::eval::scoreDepth(depth->view(), truthView, region, {.depthUnitM = unitM});
   int close = 0;
-  for (std::size_t i = 0; i < depth->pixels.size(); ++i) {
-    const float z = truth->values[i];
-    if (!std::isfinite(z)) {
-      continue;
-    }
-    ++surface;
-    if (const std::uint16_t d = depth->pixels[i]; d != 0) {
-      ++valid;
-      close += std::abs(d * unitM - z) <= 0.003 ? 1 : 0;
-    }
+  for (const float errorMm : smx::eval::depthErrorMapMm(depth->view(), truthView, unitM)) {
+    close += std::abs(errorMm) <= 3.0F ? 1 : 0;  // false for NaN: no depth or no surface
   }
-  const double completeness = surface > 0 ? static_cast<double>(valid) / surface : 0.0;
-  const double within3mm = valid > 0 ? static_cast<double>(close) / valid : 0.0;
-  std::printf("depth_check: %d surface pixels, completeness %.3f, within 3 mm %.3f\n", surface,
-              completeness, within3mm);
-  return completeness >= minCompleteness && within3mm >= 0.95 ? 0 : 1;
+  const double within3mm = score.valid > 0 ? static_cast<double>(close) / score.valid : 0.0;
+  std::printf("depth_check: %d surface pixels, completeness %.3f, within 3 mm %.3f\n",
+              score.regionPixels, score.completeness, within3mm);
+  return score.completeness >= minCompleteness && within3mm >= 0.95 ? 0 : 1;
 }

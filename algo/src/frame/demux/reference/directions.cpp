@@ -168,6 +168,11 @@ struct Projector {
   [[nodiscard]] std::int32_t offset(std::size_t t) const {
     return wrapDiff(tiles[t].angle, prediction(t));
   }
+  // Tile t's prediction shifted by the mean of n offsets summing to `sum` (n > 0).
+  [[nodiscard]] std::uint16_t predictionShifted(std::size_t t, std::int32_t sum,
+                                                std::int32_t n) const {
+    return static_cast<std::uint16_t>(prediction(t) + static_cast<std::uint16_t>(sum / n));
+  }
 };
 
 Projector projector(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
@@ -241,6 +246,30 @@ void assignTile(const DemuxLayout& layout, std::span<const std::uint16_t> predic
 constexpr std::uint8_t kGrowing = 2;
 constexpr std::uint8_t kGrown = 3;
 
+// The unused lobe of tile t nearest `guess` within kGrowTolerance2 and no nearer another
+// projector's direction found in the tile; −1 when there is none.
+int growthLobe(const DemuxLayout& layout, std::span<const std::uint16_t> predicted,
+               std::span<TileDirection> out, int p, std::size_t t, const Lobes& lobes,
+               std::uint16_t guess) {
+  int best = -1;
+  std::int32_t bestDiff = kGrowTolerance2 + 1;
+  for (int l = 0; l < lobes.count; ++l) {
+    const std::int32_t diff = wrapDistance(lobes.lobe[l].angle2, doubled(guess));
+    bool nearerOther = false;
+    for (int q = 0; q < layout.projectors; ++q) {
+      const TileDirection& other = projector(layout, predicted, out, q).tiles[t];
+      nearerOther =
+          nearerOther || (q != p && other.present != 0 &&
+                          wrapDistance(lobes.lobe[l].angle2, doubled(other.angle)) <= diff);
+    }
+    if (!lobes.lobe[l].used && !nearerOther && diff < bestDiff) {
+      bestDiff = diff;
+      best = l;
+    }
+  }
+  return best;
+}
+
 void grow(const DemuxLayout& layout, const Tiles& grid, std::span<const std::uint32_t> weights,
           std::span<const std::int32_t> moments, std::span<const std::uint16_t> predicted,
           std::span<TileDirection> out) {
@@ -269,27 +298,11 @@ void grow(const DemuxLayout& layout, const Tiles& grid, std::span<const std::uin
           if (count == 0 || !nextToNew) {
             continue;
           }
-          const auto guess = static_cast<std::uint16_t>(pr.prediction(t) +
-                                                        static_cast<std::uint16_t>(sum / count));
+          const std::uint16_t guess = pr.predictionShifted(t, sum, count);
           const Lobes lobes =
               findLobes(windowOf(grid, tx, ty, layout.params.windowTiles / 2, weights, moments),
                         weights.data() + t * kBins, minSharePct);
-          int best = -1;
-          std::int32_t bestDiff = kGrowTolerance2 + 1;
-          for (int l = 0; l < lobes.count; ++l) {
-            const std::int32_t diff = wrapDistance(lobes.lobe[l].angle2, doubled(guess));
-            bool nearerOther = false;
-            for (int q = 0; q < layout.projectors; ++q) {
-              const TileDirection& other = projector(layout, predicted, out, q).tiles[t];
-              nearerOther =
-                  nearerOther || (q != p && other.present != 0 &&
-                                  wrapDistance(lobes.lobe[l].angle2, doubled(other.angle)) <= diff);
-            }
-            if (!lobes.lobe[l].used && !nearerOther && diff < bestDiff) {
-              bestDiff = diff;
-              best = l;
-            }
-          }
+          const int best = growthLobe(layout, predicted, out, p, t, lobes, guess);
           if (best >= 0) {
             pr.tiles[t] = {axisTowards(lobes.lobe[best].angle2, guess), kGrowing};
             grew = true;
@@ -365,8 +378,7 @@ void fillAbsent(const DemuxLayout& layout, const Tiles& grid,
           }
         });
         if (count > 0) {
-          pr.tiles[t].angle = static_cast<std::uint16_t>(pr.prediction(t) +
-                                                         static_cast<std::uint16_t>(sum / count));
+          pr.tiles[t].angle = pr.predictionShifted(t, sum, count);
         }
       }
     }

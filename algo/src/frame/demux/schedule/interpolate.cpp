@@ -1,5 +1,5 @@
 // Direction planes, the schedule of interpolateDirections() (reference:
-// reference/interpolation.cpp): each projector's tile angles interpolated bilinearly between tile
+// reference/interpolate.cpp): each projector's tile angles interpolated bilinearly between tile
 // centres, as wrapped differences from the lower-left tile's angle, per pixel.
 #include <cstdint>
 

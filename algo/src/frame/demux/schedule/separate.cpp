@@ -1,4 +1,4 @@
-// Stage 3, the schedule of separate() (reference: reference/separation.cpp): pattern separation
+// Stage 3, the schedule of separate() (reference: reference/separate.cpp): pattern separation
 // by steered derivatives (paper eqs 6–10), every projector in one sweep over the rows. The
 // division by the local colour (§4.3) is detectBoundaries()'.
 //   Directions: each projector's tile angles interpolated bilinearly (as wrapped differences)
