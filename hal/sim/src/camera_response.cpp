@@ -8,7 +8,7 @@
 namespace smx::sim::detail {
 
 Vignetting::Vignetting(const algo::Camera& camera, double v)
-    : v_(v), cx_(camera.K[2]), cy_(camera.K[5]), inverseCorner2_(0.0) {
+    : v_(v), cx_(camera.K[2]), cy_(camera.K[5]) {
   double corner2 = 0.0;
   for (const double x : {-0.5, camera.width - 0.5}) {
     for (const double y : {-0.5, camera.height - 0.5}) {

@@ -26,7 +26,7 @@ class Vignetting {
   double v_;
   double cx_;
   double cy_;
-  double inverseCorner2_;  // 1 / r_corner²
+  double inverseCorner2_ = 0.0;  // 1 / r_corner²
 };
 
 // grey ← 255·(grey/255)^(1/γ) per channel (0 below 0); γ = 1 leaves the image untouched.

@@ -499,6 +499,7 @@ std::vector<double> EmbreeRenderer::exposureTimes(int frame) const {
     return {static_cast<double>(frame)};
   }
   std::vector<double> times;
+  times.reserve(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
     times.push_back(frame + e * ((k + 0.5) / n - 0.5));
   }
