@@ -275,7 +275,7 @@ double blinnPhong(const Vec3& normal, const Vec3& toLight, const Vec3& toEye, do
 
 struct ProjectorState {
   Vec3 centre;
-  std::vector<RgbF> light;  // pattern image / 255 after the defocus blur, row-major
+  std::vector<RgbF> light;  // emitted light per pattern pixel after the defocus blur, row-major
 };
 
 class EmbreeRenderer final : public Renderer {
