@@ -99,6 +99,15 @@ def json_seeds():
              "albedo": {"texture": {"path": "texture.png", "width_m": 0.1, "height_m": 0.1}}},
             {"shape": {"type": "box", "size_m": [0.1, 0.1, 0.1]},
              "motion": {"velocity_m_per_frame": [0.002, 0, 0]}}]}))
+    write("scene", "realism.json", json.dumps({
+        "format": "stripemux-scene/1",
+        "lighting": {"projector_black_level": 0.002, "projector_gamma": 2.2},
+        "camera_response": {"response_gamma": 2.2, "vignetting": 0.3, "bayer": "rggb",
+                            "exposure": 0.5, "exposure_samples": 4},
+        "objects": [
+            {"shape": {"type": "sphere", "radius_m": 0.1}, "pose": {"t": [0, 0, 0.8]},
+             "motion": {"velocity_m_per_frame": [0.002, 0, 0]},
+             "albedo": {"rgb": [0.5, 0.5, 0.5], "specular": 0.3, "shininess": 200}}]}))
     write("scene", "near_minimal.json",
           '{"format": "stripemux-scene/1", "objects": [{"shape": {"type": "plane"}}]}')
 

@@ -63,9 +63,12 @@ constexpr std::string_view kValidScene = R"({
   "format": "stripemux-scene/1",
   "supersampling": 3,
   "lighting": {"ambient": [0.01, 0.02, 0.04], "projector_power": 0.75, "inverse_square": true,
-               "reference_distance_m": 1.25, "projector_defocus_sigma_px": 0.5},
+               "reference_distance_m": 1.25, "projector_defocus_sigma_px": 0.5,
+               "projector_black_level": 0.01, "projector_gamma": 2.2},
   "camera_response": {"crosstalk": [0.9, 0.05, 0.01, 0.04, 0.85, 0.06, 0.02, 0.07, 0.8],
-                      "gain": 1.5, "noise_sigma": [2, 1.5, 0.25], "defocus_sigma_px": 0.75},
+                      "gain": 1.5, "noise_sigma": [2, 1.5, 0.25], "defocus_sigma_px": 0.75,
+                      "response_gamma": 1.8, "vignetting": 0.3, "bayer": "grbg",
+                      "exposure": 0.5, "exposure_samples": 5},
   "objects": [
     {"name": "wall", "shape": {"type": "plane", "width_m": 1.2, "height_m": 0.9},
      "pose": {"t": [0, 0, 1.1]},
@@ -76,7 +79,8 @@ constexpr std::string_view kValidScene = R"({
                 "angular_deg_per_frame": 1.5, "pivot": [0.15, -0.25, 0.95]},
      "albedo": {"rgb": [0.2, 0.4, 0.6]}},
     {"name": "ball", "shape": {"type": "sphere", "radius_m": 0.07},
-     "pose": {"rotation_deg": [0, 90, 0]}},
+     "pose": {"rotation_deg": [0, 90, 0]},
+     "albedo": {"rgb": [0.5, 0.5, 0.5], "specular": 0.4, "shininess": 120}},
     {"shape": {"type": "cylinder", "radius_m": 0.03, "height_m": 0.25, "capped": false}},
     {"name": "square", "shape": {"type": "mesh", "path": "square.obj"}}
   ]
@@ -257,6 +261,8 @@ TEST(SceneJson, ValidSceneIsReadFieldByField) {
   EXPECT_TRUE(scene->lighting.inverseSquare);
   EXPECT_EQ(scene->lighting.referenceDistanceM, 1.25);
   EXPECT_EQ(scene->lighting.projectorDefocusSigmaPx, 0.5);
+  EXPECT_EQ(scene->lighting.projectorBlackLevel, 0.01);
+  EXPECT_EQ(scene->lighting.projectorGamma, 2.2);
   Mat3 crosstalk;
   crosstalk << 0.9, 0.05, 0.01, 0.04, 0.85, 0.06, 0.02, 0.07, 0.8;
   EXPECT_EQ(scene->camera.crosstalk, crosstalk);
@@ -264,6 +270,11 @@ TEST(SceneJson, ValidSceneIsReadFieldByField) {
   EXPECT_EQ(scene->camera.gain, 1.5);
   EXPECT_EQ(scene->camera.noiseSigma, Vec3(2, 1.5, 0.25));
   EXPECT_EQ(scene->camera.defocusSigmaPx, 0.75);
+  EXPECT_EQ(scene->camera.responseGamma, 1.8);
+  EXPECT_EQ(scene->camera.vignetting, 0.3);
+  EXPECT_EQ(scene->camera.bayer, "grbg");
+  EXPECT_EQ(scene->camera.exposure, 0.5);
+  EXPECT_EQ(scene->camera.exposureSamples, 5);
 
   ASSERT_EQ(scene->objects.size(), 5U);
   const Object& wall = scene->objects[0];
@@ -295,6 +306,9 @@ TEST(SceneJson, ValidSceneIsReadFieldByField) {
   ASSERT_TRUE(std::holds_alternative<Sphere>(ball.shape));
   EXPECT_EQ(std::get<Sphere>(ball.shape).radiusM, 0.07);
   expectMatrix(ball.pose.R, {0, 0, 1, 0, 1, 0, -1, 0, 0}, 0);
+  EXPECT_EQ(ball.albedo.rgb, Vec3(0.5, 0.5, 0.5));
+  EXPECT_EQ(ball.albedo.specular, 0.4);
+  EXPECT_EQ(ball.albedo.shininess, 120.0);
 
   const Object& can = scene->objects[3];
   EXPECT_EQ(can.name, "object3");  // unnamed: "object" + its index
@@ -328,6 +342,14 @@ TEST(SceneJson, DefaultsApplyToEverythingLeftOut) {
   EXPECT_EQ(scene->camera.gain, 1.0);
   EXPECT_EQ(scene->camera.noiseSigma, Vec3(1.8138, 1.2923, 1.6745));
   EXPECT_EQ(scene->camera.defocusSigmaPx, 0.0);
+  // The realism settings are off.
+  EXPECT_EQ(scene->lighting.projectorBlackLevel, 0.0);
+  EXPECT_EQ(scene->lighting.projectorGamma, 1.0);
+  EXPECT_EQ(scene->camera.responseGamma, 1.0);
+  EXPECT_EQ(scene->camera.vignetting, 0.0);
+  EXPECT_EQ(scene->camera.bayer, "none");
+  EXPECT_EQ(scene->camera.exposure, 0.0);
+  EXPECT_EQ(scene->camera.exposureSamples, 1);
 
   ASSERT_EQ(scene->objects.size(), 4U);
   for (std::size_t i = 0; i < 4; ++i) {
@@ -342,6 +364,8 @@ TEST(SceneJson, DefaultsApplyToEverythingLeftOut) {
     EXPECT_EQ(o.motion.pivot, Vec3::Zero());
     EXPECT_EQ(o.albedo.rgb, Vec3(0.8, 0.8, 0.8));
     EXPECT_TRUE(std::holds_alternative<std::monostate>(o.albedo.texture));
+    EXPECT_EQ(o.albedo.specular, 0.0);
+    EXPECT_EQ(o.albedo.shininess, 50.0);
   }
   EXPECT_EQ(std::get<Plane>(scene->objects[0].shape).widthM, 1.0);
   EXPECT_EQ(std::get<Plane>(scene->objects[0].shape).heightM, 1.0);
@@ -652,6 +676,62 @@ TEST(SceneJsonErrors, ColoursAreFractions) {
                  "objects[1].albedo.rgb[0]", {"must be between 0 and 1, got -0.1"});
   expectRejected(validSceneWith("[0, 0.5, 1]]", "[0, 0.5, 2]]"),
                  "objects[0].albedo.checker.colours[1][2]", {"must be between 0 and 1, got 2"});
+}
+
+// Given each realism setting just outside its physical range (docs/scene-format.md), when parsed,
+// then the scene is refused with the key and the range named.
+TEST(SceneJsonErrors, RealismSettingsStayInTheirPhysicalRanges) {
+  struct Case {
+    std::string_view from;
+    std::string_view to;
+    std::string_view field;
+    std::string_view problem;
+  };
+  const std::array<Case, 14> cases = {{
+      {"\"projector_black_level\": 0.01", "\"projector_black_level\": 0.25",
+       "lighting.projector_black_level", "must be from 0 to 0.2, got 0.25"},
+      {"\"projector_black_level\": 0.01", "\"projector_black_level\": -0.01",
+       "lighting.projector_black_level", "must be from 0 to 0.2, got -0.01"},
+      {"\"projector_gamma\": 2.2", "\"projector_gamma\": 0.9", "lighting.projector_gamma",
+       "must be from 1 to 3, got 0.9"},
+      {"\"response_gamma\": 1.8", "\"response_gamma\": 3.5", "camera_response.response_gamma",
+       "must be from 1 to 3, got 3.5"},
+      {"\"vignetting\": 0.3", "\"vignetting\": 0.9", "camera_response.vignetting",
+       "must be from 0 to 0.8, got 0.9"},
+      {"\"bayer\": \"grbg\"", "\"bayer\": \"rggbb\"", "camera_response.bayer",
+       R"(unknown pattern "rggbb" (did you mean "rggb"?); patterns: "none", "rggb", "bggr", )"},
+      {"\"bayer\": \"grbg\"", "\"bayer\": 1", "camera_response.bayer",
+       "must be a string, one of \"none\""},
+      {"\"exposure\": 0.5", "\"exposure\": 1.5", "camera_response.exposure",
+       "must be from 0 to 1, got 1.5"},
+      {"\"exposure_samples\": 5", "\"exposure_samples\": 0", "camera_response.exposure_samples",
+       "must be an integer from 1 to 16 (time samples over the exposure), got 0"},
+      {"\"exposure_samples\": 5", "\"exposure_samples\": 17", "camera_response.exposure_samples",
+       "got 17"},
+      {"\"exposure_samples\": 5", "\"exposure_samples\": 2.5", "camera_response.exposure_samples",
+       "got 2.5"},
+      {"\"specular\": 0.4", "\"specular\": 1.5", "objects[2].albedo.specular",
+       "must be between 0 and 1, got 1.5"},
+      {"\"shininess\": 120", "\"shininess\": 0.5", "objects[2].albedo.shininess",
+       "must be from 1 to 10000, got 0.5"},
+      {"\"shininess\": 120", "\"shininess\": 1e5", "objects[2].albedo.shininess",
+       "must be from 1 to 10000, got 100000"},
+  }};
+  for (const auto& c : cases) {
+    expectRejected(validSceneWith(c.from, c.to), c.field, {c.problem});
+  }
+}
+
+// Given a scene built in memory with an unknown mosaic, when validated, then it is refused as
+// the file would be.
+TEST(SceneJsonErrors, ValidateSceneRefusesAnUnknownBayerPattern) {
+  Scene scene;
+  scene.objects.emplace_back();
+  scene.camera.bayer = "RGGB";
+  const auto valid = config::validateScene(scene);
+  ASSERT_FALSE(valid.has_value());
+  EXPECT_EQ(valid.error().field, "camera_response.bayer");
+  EXPECT_TRUE(contains(valid.error().problem, "unknown pattern \"RGGB\"")) << valid.error().problem;
 }
 
 TEST(SceneJsonErrors, RMustBeARotation) {

@@ -54,17 +54,25 @@ using sim::Vec3;
 
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
                                                       "camera_response", "objects"};
-constexpr std::array<std::string_view, 5> kLightingKeys = {"ambient", "projector_power",
-                                                           "inverse_square", "reference_distance_m",
-                                                           "projector_defocus_sigma_px"};
-constexpr std::array<std::string_view, 4> kCameraKeys = {"crosstalk", "gain", "noise_sigma",
-                                                         "defocus_sigma_px"};
+constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
+                                                           "projector_power",
+                                                           "inverse_square",
+                                                           "reference_distance_m",
+                                                           "projector_defocus_sigma_px",
+                                                           "projector_black_level",
+                                                           "projector_gamma"};
+constexpr std::array<std::string_view, 9> kCameraKeys = {
+    "crosstalk",  "gain",  "noise_sigma", "defocus_sigma_px", "response_gamma",
+    "vignetting", "bayer", "exposure",    "exposure_samples"};
 constexpr std::array<std::string_view, 5> kObjectKeys = {"name", "shape", "pose", "motion",
                                                          "albedo"};
 constexpr std::array<std::string_view, 4> kPoseKeys = {"t", "rotation_deg", "R", "scale"};
 constexpr std::array<std::string_view, 4> kMotionKeys = {"velocity_m_per_frame", "axis",
                                                          "angular_deg_per_frame", "pivot"};
-constexpr std::array<std::string_view, 3> kAlbedoKeys = {"rgb", "checker", "texture"};
+constexpr std::array<std::string_view, 5> kAlbedoKeys = {"rgb", "checker", "texture", "specular",
+                                                         "shininess"};
+// The albedo keys of which exactly one is given.
+constexpr std::array<std::string_view, 3> kAlbedoKinds = {"rgb", "checker", "texture"};
 constexpr std::array<std::string_view, 2> kCheckerKeys = {"square_m", "colours"};
 constexpr std::array<std::string_view, 3> kTextureKeys = {"path", "width_m", "height_m"};
 
@@ -74,6 +82,9 @@ constexpr std::array<std::string_view, 2> kSphereKeys = {"type", "radius_m"};
 constexpr std::array<std::string_view, 4> kCylinderKeys = {"type", "radius_m", "height_m",
                                                            "capped"};
 constexpr std::array<std::string_view, 2> kMeshKeys = {"type", "path"};
+
+// Time samples over one exposure: 16 steps keep a blur of a few pixels smooth.
+constexpr int kMaxExposureSamples = 16;
 
 struct ShapeType {
   std::string_view name;
@@ -187,6 +198,16 @@ void readLighting(Reader& r, const Json& doc, Lighting& out) {
   r.boolean(*v, path, "inverse_square", out.inverseSquare);
   r.number(*v, path, "reference_distance_m", Range::kAny, out.referenceDistanceM);
   r.number(*v, path, "projector_defocus_sigma_px", Range::kAny, out.projectorDefocusSigmaPx);
+  r.number(*v, path, "projector_black_level", Range::kAny, out.projectorBlackLevel);
+  r.number(*v, path, "projector_gamma", Range::kAny, out.projectorGamma);
+}
+
+std::string bayerNames() {
+  std::string out;
+  for (const auto name : sim::kBayerPatterns) {
+    out += (out.empty() ? "" : ", ") + jsonQuote(name);
+  }
+  return out;
 }
 
 void readCameraResponse(Reader& r, const Json& doc, CameraResponse& out) {
@@ -200,6 +221,19 @@ void readCameraResponse(Reader& r, const Json& doc, CameraResponse& out) {
   r.number(*v, path, "gain", Range::kAny, out.gain);
   r.vec3(*v, path, "noise_sigma", "r, g, b in grey levels", Range::kAny, out.noiseSigma);
   r.number(*v, path, "defocus_sigma_px", Range::kAny, out.defocusSigmaPx);
+  r.number(*v, path, "response_gamma", Range::kAny, out.responseGamma);
+  r.number(*v, path, "vignetting", Range::kAny, out.vignetting);
+  if (const Json* bayer = r.find(*v, "bayer"); bayer != nullptr) {
+    if (bayer->is_string()) {
+      out.bayer = bayer->get<std::string>();
+    } else {
+      r.fail(member(path, "bayer"),
+             "must be a string, one of " + bayerNames() + "; got " + describe(*bayer));
+    }
+  }
+  r.number(*v, path, "exposure", Range::kAny, out.exposure);
+  r.integer(*v, path, "exposure_samples", 1, kMaxExposureSamples, "time samples over the exposure",
+            out.exposureSamples);
 }
 
 std::string shapeTypeNames() {
@@ -388,7 +422,9 @@ void readAlbedo(Reader& r, const Json& obj, const std::string& objectPath, Albed
     return;
   }
   std::vector<std::string_view> given;
-  for (const auto key : kAlbedoKeys) {
+  r.number(*v, path, "specular", Range::kAny, out.specular);
+  r.number(*v, path, "shininess", Range::kAny, out.shininess);
+  for (const auto key : kAlbedoKinds) {
     if (v->contains(key)) {
       given.push_back(key);
     }
@@ -424,6 +460,14 @@ void checkSupersampling(Reader& r, int supersampling) {
   r.check(supersampling, "supersampling", 1, sim::kMaxSceneSupersampling, "samples per pixel side");
 }
 
+// lo ≤ d ≤ hi, the physical range of a setting.
+void checkBetween(Reader& r, double d, const std::string& path, double lo, double hi) {
+  if (r.check(d, path, Range::kAny) && (d < lo || d > hi)) {
+    r.fail(path, "must be from " + formatNumber(lo) + " to " + formatNumber(hi) + ", got " +
+                     formatNumber(d));
+  }
+}
+
 void checkLighting(Reader& r, const Lighting& l) {
   const std::string path = "lighting";
   // Above 1 the ambient alone saturates the camera: sunlight on a scanner, which the eval sweeps.
@@ -432,6 +476,10 @@ void checkLighting(Reader& r, const Lighting& l) {
   r.check(l.referenceDistanceM, member(path, "reference_distance_m"), Range::kPositive);
   r.check(l.projectorDefocusSigmaPx, member(path, "projector_defocus_sigma_px"),
           Range::kNonNegative);
+  // 0.2 is a 5:1 contrast, a projector washed out by room light; beyond it no stripe survives.
+  checkBetween(r, l.projectorBlackLevel, member(path, "projector_black_level"), 0.0, 0.2);
+  // Displays run from linear (1) to a CRT-like 2.2–2.6; 3 covers the steepest.
+  checkBetween(r, l.projectorGamma, member(path, "projector_gamma"), 1.0, 3.0);
 }
 
 void checkCameraResponse(Reader& r, const CameraResponse& c) {
@@ -441,6 +489,19 @@ void checkCameraResponse(Reader& r, const CameraResponse& c) {
   r.check(c.gain, member(path, "gain"), Range::kPositive);
   r.checkEach(c.noiseSigma, member(path, "noise_sigma"), Range::kNonNegative);
   r.check(c.defocusSigmaPx, member(path, "defocus_sigma_px"), Range::kNonNegative);
+  checkBetween(r, c.responseGamma, member(path, "response_gamma"), 1.0, 3.0);
+  // 0.8 is an 80 % loss at the corner, a cheap wide-angle lens wide open.
+  checkBetween(r, c.vignetting, member(path, "vignetting"), 0.0, 0.8);
+  if (r.ok() && std::ranges::find(sim::kBayerPatterns, c.bayer) == sim::kBayerPatterns.end()) {
+    const std::string_view guess = closestWord(c.bayer, sim::kBayerPatterns);
+    r.fail(member(path, "bayer"),
+           "unknown pattern " + jsonQuote(c.bayer) +
+               (guess.empty() ? "" : " (did you mean " + jsonQuote(guess) + "?)") +
+               "; patterns: " + bayerNames());
+  }
+  checkBetween(r, c.exposure, member(path, "exposure"), 0.0, 1.0);
+  r.check(c.exposureSamples, member(path, "exposure_samples"), 1, kMaxExposureSamples,
+          "time samples over the exposure");
 }
 
 void checkShape(Reader& r, const Shape& shape, const std::string& path) {
@@ -502,6 +563,8 @@ void checkAlbedo(Reader& r, const Albedo& a, const std::string& path) {
   } else {
     r.checkEach(a.rgb, member(path, "rgb"), Range::kFraction);
   }
+  r.check(a.specular, member(path, "specular"), Range::kFraction);
+  checkBetween(r, a.shininess, member(path, "shininess"), 1.0, 10000.0);
 }
 
 // An object's values, in the order its parts are read.

@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "camera_response.hpp"
 #include "gaussian_blur.hpp"
 #include "shape_geometry.hpp"
 #include "smx/algo/lens.hpp"
@@ -92,12 +93,12 @@ bool moves(const Motion& m) {
   return !m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0;
 }
 
-// scene.hpp: rotate by f·angle about `axis` through `pivot`, then translate by f·velocity.
-FramePose poseAt(const Object& object, int frame) {
-  if (frame == 0 || !moves(object.motion)) {
+// scene.hpp: rotate by f·angle about `axis` through `pivot`, then translate by f·velocity; f is
+// the time in frames (fractional within an exposure).
+FramePose poseAt(const Object& object, double f) {
+  if (f == 0.0 || !moves(object.motion)) {
     return {object.pose.R, object.pose.t, object.pose.scale};
   }
-  const double f = frame;
   const auto& m = object.motion;
   const Mat3 turn =
       Eigen::AngleAxisd(f * m.angularDegPerFrame * std::numbers::pi / 180.0, m.axis.normalized())
@@ -111,7 +112,7 @@ FramePose poseAt(const Object& object, int frame) {
 // after the geometries are created).
 struct ObjectState {
   const Object* object = nullptr;
-  FramePose pose;  // at the committed frame
+  FramePose pose;  // at the committed time
   std::vector<detail::Surface> surfaces;
   GeometryHandle geometry;  // in the world scene: a user geometry, or an instance of meshScene
   SceneHandle meshScene;    // meshes: the triangles in local coordinates
@@ -265,9 +266,16 @@ struct Illumination {
   double distanceM = 0.0;
 };
 
+// Blinn–Phong lobe (n·h)^shininess, h the half vector of the unit directions to the light and to
+// the eye; 0 where h points away from the surface.
+double blinnPhong(const Vec3& normal, const Vec3& toLight, const Vec3& toEye, double shininess) {
+  const double cosine = normal.dot((toLight + toEye).normalized());
+  return cosine > 0.0 ? std::pow(cosine, shininess) : 0.0;
+}
+
 struct ProjectorState {
   Vec3 centre;
-  std::vector<RgbF> light;  // pattern image / 255 after the defocus blur, row-major
+  std::vector<RgbF> light;  // emitted light per pattern pixel after the defocus blur, row-major
 };
 
 class EmbreeRenderer final : public Renderer {
@@ -286,22 +294,27 @@ class EmbreeRenderer final : public Renderer {
     GroundTruthViews* truth = nullptr;
     std::vector<double> sampleOffsets;              // stratum centres within a pixel, per axis
     const std::vector<RgbF>* sampleRays = nullptr;  // cached directions, or null: undistort
+    double timeWeight = 1.0;                        // of this time sample in the exposure
+    bool firstTime = true;                          // the first time sample: overwrite
   };
 
   std::expected<void, std::string> initProjectors();
   std::expected<void, std::string> initGeometry();
   std::expected<void, std::string> check(const FrameRequest& request, algo::RgbView image,
                                          const GroundTruthViews* truth) const;
-  void setFrame(int frame);
+  void setTime(double time);
+  [[nodiscard]] std::vector<double> exposureTimes(int frame) const;
   const std::vector<RgbF>* sampleRays(const FrameContext& ctx, int cameraIndex);
   void shadeRow(const FrameContext& ctx, int y);
+  void exposeRow(const algo::Camera& camera, int y);
   void writeTruth(const FrameContext& ctx, int x, int y) const;
   void addNoiseAndQuantise(const FrameRequest& request, algo::RgbView image) const;
 
   [[nodiscard]] std::optional<SurfacePoint> trace(const Vec3& origin, const Vec3& dir) const;
   [[nodiscard]] bool occluded(const Vec3& from, const Vec3& to) const;
   [[nodiscard]] std::optional<Illumination> illuminate(std::size_t p, const SurfacePoint& s) const;
-  [[nodiscard]] Vec3 radiance(const SurfacePoint& s, const std::vector<bool>& lit) const;
+  [[nodiscard]] Vec3 radiance(const SurfacePoint& s, const std::vector<bool>& lit,
+                              const Vec3& eye) const;
 
   algo::Rig rig_;
   Scene scene_;
@@ -311,7 +324,9 @@ class EmbreeRenderer final : public Renderer {
   std::vector<ObjectState> objects_;  // index = geometry ID in world_
   SceneHandle world_;
   bool anyMotion_ = false;
-  int frame_ = 0;  // the frame world_ is committed for
+  double time_ = 0.0;  // the time (frames) world_ is committed for
+  std::optional<detail::BayerCell> bayer_;
+  std::vector<Vec3> radiance_;  // per pixel: mean reflected light over samples and exposure
   std::vector<RgbF> linear_;
   std::vector<std::vector<RgbF>> sampleRays_;  // per camera: direction of every sample, float
 };
@@ -324,7 +339,21 @@ std::expected<void, std::string> EmbreeRenderer::init() {
   if (auto ok = initProjectors(); !ok) {
     return ok;
   }
+  bayer_ = detail::bayerCell(scene_.camera.bayer);
   return initGeometry();
+}
+
+// The projector's display: a pattern level in [0, 1] becomes black + (1 − black)·level^γ of a full
+// pixel's light. Before the lens blur, which acts on the emitted light.
+void emit(std::vector<RgbF>& light, double black, double gamma) {
+  if (black == 0.0 && gamma == 1.0) {
+    return;
+  }
+  for (RgbF& px : light) {
+    for (float& c : px) {
+      c = static_cast<float>(black + (1.0 - black) * std::pow(static_cast<double>(c), gamma));
+    }
+  }
 }
 
 std::expected<void, std::string> EmbreeRenderer::initProjectors() {
@@ -353,6 +382,7 @@ std::expected<void, std::string> EmbreeRenderer::initProjectors() {
                         static_cast<float>(pattern[i].g) / 255.0F,
                         static_cast<float>(pattern[i].b) / 255.0F};
     }
+    emit(state.light, scene_.lighting.projectorBlackLevel, scene_.lighting.projectorGamma);
     detail::gaussianBlur(state.light, model.width, model.height,
                          scene_.lighting.projectorDefocusSigmaPx, detail::Border::kBlack);
   }
@@ -442,22 +472,38 @@ std::expected<void, std::string> EmbreeRenderer::initGeometry() {
   return {};
 }
 
-void EmbreeRenderer::setFrame(int frame) {
-  if (frame == frame_ || !anyMotion_) {
+void EmbreeRenderer::setTime(double time) {
+  if (time == time_ || !anyMotion_) {
     return;
   }
   for (auto& state : objects_) {
     if (!moves(state.object->motion)) {
       continue;
     }
-    state.pose = poseAt(*state.object, frame);
+    state.pose = poseAt(*state.object, time);
     if (state.meshScene) {
       setInstanceTransform(state.geometry.get(), state.pose);
     }
     rtcCommitGeometry(state.geometry.get());  // user geometries: bounds read the new pose
   }
   rtcCommitScene(world_.get());
-  frame_ = frame;
+  time_ = time;
+}
+
+// The frame's instant, or the stratum centres of [frame − e/2, frame + e/2] when something
+// moves during a non-zero exposure e (a still scene looks the same at every instant).
+std::vector<double> EmbreeRenderer::exposureTimes(int frame) const {
+  const double e = scene_.camera.exposure;
+  const int n = scene_.camera.exposureSamples;
+  if (!(e > 0.0) || !anyMotion_ || n <= 1) {
+    return {static_cast<double>(frame)};
+  }
+  std::vector<double> times;
+  times.reserve(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    times.push_back(frame + e * ((k + 0.5) / n - 0.5));
+  }
+  return times;
 }
 
 std::optional<SurfacePoint> EmbreeRenderer::trace(const Vec3& origin, const Vec3& dir) const {
@@ -561,9 +607,13 @@ std::optional<Illumination> EmbreeRenderer::illuminate(std::size_t p, const Surf
   return il;
 }
 
-Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& lit) const {
+Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& lit,
+                              const Vec3& eye) const {
   const auto& lighting = scene_.lighting;
+  const ObjectState& state = objects_[s.object];
+  const Albedo& albedo = state.object->albedo;
   Vec3 irradiance = lighting.ambient;
+  Vec3 gloss = Vec3::Zero();
   for (std::size_t p = 0; p < projectors_.size(); ++p) {
     if (!lit[p]) {
       continue;
@@ -578,14 +628,18 @@ Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& li
       w *= ratio * ratio;
     }
     const RgbF& c = projectors_[p].light[il->pixel];
-    irradiance += w * Vec3(c[0], c[1], c[2]);
+    const Vec3 e = w * Vec3(c[0], c[1], c[2]);
+    irradiance += e;
+    if (albedo.specular > 0.0) {
+      const Vec3 toLight = (projectors_[p].centre - s.point) / il->distanceM;
+      gloss += albedo.specular *
+               blinnPhong(s.normal, toLight, (eye - s.point).normalized(), albedo.shininess) * e;
+    }
   }
-  const ObjectState& state = objects_[s.object];
-  const Albedo& albedo = state.object->albedo;
-  if (std::holds_alternative<std::monostate>(albedo.texture)) {
-    return albedo.rgb.cwiseProduct(irradiance);
-  }
-  return albedoAt(albedo, state.pose.toLocal(s.point)).cwiseProduct(irradiance);
+  const Vec3 diffuse = std::holds_alternative<std::monostate>(albedo.texture)
+                           ? albedo.rgb.cwiseProduct(irradiance)
+                           : albedoAt(albedo, state.pose.toLocal(s.point)).cwiseProduct(irradiance);
+  return albedo.specular > 0.0 ? Vec3(diffuse + gloss) : diffuse;
 }
 
 void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
@@ -593,7 +647,6 @@ void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
   const Vec3 centre = toVec(lens::centre(camera));
   const double perSample =
       1.0 / static_cast<double>(ctx.sampleOffsets.size() * ctx.sampleOffsets.size());
-  const Mat3 response = scene_.camera.gain * 255.0 * scene_.camera.crosstalk;
   for (int x = 0; x < camera.width; ++x) {
     Vec3 sum = Vec3::Zero();
     std::size_t sample =
@@ -611,16 +664,25 @@ void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
           continue;  // beyond the range of the distortion model
         }
         if (const auto s = trace(centre, dir)) {
-          sum += radiance(*s, *ctx.lit);
+          sum += radiance(*s, *ctx.lit, centre);
         }
       }
     }
-    const Vec3 grey = response * (perSample * sum);
-    linear_[pixelIndex(x, y, camera.width)] = {
-        static_cast<float>(grey.x()), static_cast<float>(grey.y()), static_cast<float>(grey.z())};
-    if (ctx.truth != nullptr) {
-      writeTruth(ctx, x, y);
-    }
+    const Vec3 mean = ctx.timeWeight * (perSample * sum);
+    Vec3& out = radiance_[pixelIndex(x, y, camera.width)];
+    out = ctx.firstTime ? mean : Vec3(out + mean);
+  }
+}
+
+// Vignetting, then crosstalk and gain: linear grey levels.
+void EmbreeRenderer::exposeRow(const algo::Camera& camera, int y) {
+  const detail::Vignetting vignetting(camera, scene_.camera.vignetting);
+  const Mat3 response = scene_.camera.gain * 255.0 * scene_.camera.crosstalk;
+  for (int x = 0; x < camera.width; ++x) {
+    const std::size_t i = pixelIndex(x, y, camera.width);
+    const Vec3 grey = response * (vignetting.gain(x, y) * radiance_[i]);
+    linear_[i] = {static_cast<float>(grey.x()), static_cast<float>(grey.y()),
+                  static_cast<float>(grey.z())};
   }
 }
 
@@ -781,7 +843,6 @@ std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& requ
   if (auto ok = check(request, image, truth); !ok) {
     return ok;
   }
-  setFrame(request.frame);
   FrameContext ctx;
   ctx.camera = &rig_.cameras[static_cast<std::size_t>(request.camera)];
   ctx.lit = &request.lit;
@@ -793,11 +854,33 @@ std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& requ
   ctx.sampleRays = sampleRays(ctx, request.camera);
   const int width = ctx.camera->width;
   const int height = ctx.camera->height;
-  linear_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), RgbF{});
-  forEachRow(height, [&](int y) { shadeRow(ctx, y); });
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  radiance_.resize(pixels);
+  linear_.resize(pixels);
+  const std::vector<double> times = exposureTimes(request.frame);
+  ctx.timeWeight = 1.0 / static_cast<double>(times.size());
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    setTime(times[k]);
+    ctx.firstTime = k == 0;
+    forEachRow(height, [&](int y) { shadeRow(ctx, y); });
+  }
+  forEachRow(height, [&](int y) { exposeRow(*ctx.camera, y); });
   detail::gaussianBlur(linear_, width, height, scene_.camera.defocusSigmaPx,
                        detail::Border::kClampToEdge);
+  detail::applyResponseGamma(linear_, scene_.camera.responseGamma);
   addNoiseAndQuantise(request, image);
+  if (bayer_) {
+    detail::mosaicAndDemosaic(image, *bayer_);
+  }
+  if (truth != nullptr) {
+    // At the frame's own instant, the middle of the exposure.
+    setTime(request.frame);
+    forEachRow(height, [&](int y) {
+      for (int x = 0; x < width; ++x) {
+        writeTruth(ctx, x, y);
+      }
+    });
+  }
   return {};
 }
 

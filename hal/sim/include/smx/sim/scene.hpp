@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -54,6 +55,11 @@ struct ImageTexture {
 struct Albedo {
   Vec3 rgb{0.8, 0.8, 0.8};  // constant albedo in [0, 1] per channel (used when no texture)
   std::variant<std::monostate, CheckerTexture, ImageTexture> texture;
+  // Blinn–Phong gloss of projector light: specular · (n·h)^shininess · irradiance, h the half
+  // vector between the directions to the projector and to the camera. albedo + specular may
+  // exceed 1 only as glossy highlights do.
+  double specular = 0.0;    // [0, 1]
+  double shininess = 50.0;  // [1, 10000]
 };
 
 // Shapes, in object-local coordinates, centred on the local origin.
@@ -97,13 +103,36 @@ struct Lighting {
   bool inverseSquare = false;  // 1/d² falloff relative to referenceDistanceM
   double referenceDistanceM = 0.9;
   double projectorDefocusSigmaPx = 0.0;  // Gaussian blur of the projector image, projector px
+  // Light of a black projector pixel as a fraction of a full one (finite contrast: 0.001 is
+  // 1000:1); [0, 0.2].
+  double projectorBlackLevel = 0.0;
+  // Display response: emitted = level^gamma per channel, levels in [0, 1]; [1, 3].
+  double projectorGamma = 1.0;
 };
+
+// The values of CameraResponse::bayer: no mosaic, or the colours of the 2 × 2 cell from its top
+// left pixel, row by row.
+inline constexpr std::array<std::string_view, 5> kBayerPatterns = {"none", "rggb", "bggr", "grbg",
+                                                                   "gbrg"};
 
 struct CameraResponse {
   Mat3 crosstalk = Mat3::Identity();        // camera RGB = crosstalk · scene RGB
   double gain = 1.0;                        // exposure gain
   Vec3 noiseSigma{1.8138, 1.2923, 1.6745};  // Gaussian noise per channel, grey levels
   double defocusSigmaPx = 0.0;              // Gaussian blur of the camera image, camera px
+  // grey = 255·(linear/255)^(1/responseGamma), after crosstalk, gain and defocus; [1, 3].
+  double responseGamma = 1.0;
+  // Relative light loss at the image corner: gain(r) = 1 − vignetting·(r/r_corner)², r from the
+  // principal point; [0, 0.8].
+  double vignetting = 0.0;
+  // Colour-filter mosaic: "none", "rggb", "bggr", "grbg" or "gbrg" (the 2 × 2 cell from the top
+  // left). The sensor keeps one channel per pixel after quantisation; a bilinear demosaic
+  // restores RGB.
+  std::string bayer = "none";
+  // Exposure time as a fraction of the frame interval: moving objects are integrated over
+  // [frame − exposure/2, frame + exposure/2] (motion blur); [0, 1].
+  double exposure = 0.0;
+  int exposureSamples = 1;  // time samples over the exposure, 1 to 16; unused when exposure is 0
 };
 
 // The most samples per pixel side a scene asks for (64 rays per pixel: beyond that, render larger):
