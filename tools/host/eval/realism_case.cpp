@@ -334,8 +334,10 @@ Meshes loadMeshes() {
 // The bunny's bounding-box centre in its own coordinates (y up), metres.
 const Vec3 kBunnyCentre(-0.0168, 0.1100, -0.0016);
 
-// One object centred at `at`; returns its name and its extent below the centre (+y), metres.
-std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const Vec3& at) {
+// One object centred at `at`, its size scaled by k; returns it and its extent below the centre
+// (+y), metres.
+std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const Vec3& at,
+                                          double k) {
   sim::Object o;
   o.pose.t = at;
   double below = 0;
@@ -343,7 +345,7 @@ std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const 
     case 0: {
       o.name = "bunny";
       o.shape = meshes.bunny;
-      o.pose.scale = rng.uniform(1.2, 2.4);
+      o.pose.scale = k * rng.uniform(1.2, 2.4);
       // The mesh is y-up: turned upside down about z, then yawed and tipped.
       o.pose.R = rotY(rng.uniform(-70, 70) * kDeg) * rotX(rng.uniform(-15, 15) * kDeg) * rotZ(kPi);
       o.pose.t = at - (o.pose.R * (o.pose.scale * kBunnyCentre));
@@ -353,19 +355,20 @@ std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const 
     case 1:
       o.name = "head";
       o.shape = meshes.head;
-      o.pose.scale = rng.uniform(0.025, 0.042);
+      o.pose.scale = k * rng.uniform(0.025, 0.042);
       o.pose.R = rotY(rng.uniform(-50, 50) * kDeg) * rotX(rng.uniform(-15, 15) * kDeg) * rotX(kPi);
       below = 4.0 * o.pose.scale;
       break;
     case 2: {
-      const double r = rng.uniform(0.04, 0.14);
+      const double r = k * rng.uniform(0.04, 0.14);
       o.name = "sphere";
       o.shape = sim::Sphere{r};
       below = r;
       break;
     }
     case 3: {
-      const Vec3 size(rng.uniform(0.05, 0.25), rng.uniform(0.05, 0.25), rng.uniform(0.05, 0.25));
+      const Vec3 size =
+          k * Vec3(rng.uniform(0.05, 0.25), rng.uniform(0.05, 0.25), rng.uniform(0.05, 0.25));
       o.name = "box";
       o.shape = sim::Box{size};
       o.pose.R = randomRotation(rng);
@@ -373,7 +376,8 @@ std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const 
       break;
     }
     case 4: {
-      const sim::Cylinder c{rng.uniform(0.03, 0.10), rng.uniform(0.08, 0.30), rng.chance(0.7)};
+      const sim::Cylinder c{k * rng.uniform(0.03, 0.10), k * rng.uniform(0.08, 0.30),
+                            rng.chance(0.7)};
       o.name = "cylinder";
       o.shape = c;
       o.pose.R = rotZ(rng.uniform(-40, 40) * kDeg) * rotX(rng.uniform(-40, 40) * kDeg) *
@@ -382,7 +386,7 @@ std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const 
       break;
     }
     default: {
-      const sim::Plane p{rng.uniform(0.12, 0.35), rng.uniform(0.12, 0.35)};
+      const sim::Plane p{k * rng.uniform(0.12, 0.35), k * rng.uniform(0.12, 0.35)};
       o.name = "plane";
       o.shape = p;
       // Up to 70° off frontal about a random in-plane axis: steep tilts shrink the stripes.
@@ -489,7 +493,8 @@ RealismCase generateRealismCase(std::uint64_t seed, int index, const RealismOpti
   for (int i = 0; i < objects; ++i) {
     const Vec3 at(rng.uniform(-0.12, 0.12) * d, rng.uniform(-0.08, 0.08) * d,
                   d + rng.uniform(-0.08, 0.08));
-    auto [object, below] = drawObject(rng, meshes, at);
+    // Sizes follow the distance: a near scan frames smaller things.
+    auto [object, below] = drawObject(rng, meshes, at, std::clamp(d / 0.9, 0.65, 1.2));
     lowest = std::max(lowest, at.y() + below);
     names += (i == 0 ? "" : ", ") + object.name;
     scene.objects.push_back(std::move(object));
