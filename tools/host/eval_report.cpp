@@ -436,7 +436,12 @@ void realismSection(Writer& w, const eval::Report& r) {
      << " px from a depth discontinuity of the truth. Aggregates are sums of the pixel counts "
         "over all runs, not means of the ratios.\n\n";
 
-  std::vector<eval::DepthScore> lit, smooth, lit2, lit3, resolvable, band;
+  std::vector<eval::DepthScore> lit;
+  std::vector<eval::DepthScore> smooth;
+  std::vector<eval::DepthScore> lit2;
+  std::vector<eval::DepthScore> lit3;
+  std::vector<eval::DepthScore> resolvable;
+  std::vector<eval::DepthScore> band;
   int refused = 0;
   double worstGross = 0;
   double worstResolvable = 1;

@@ -105,9 +105,9 @@ std::array<double, 9> aimedRotation(const Vec3& centre, const Vec3& target, doub
       std::cos(pitchRad);
   const Mat3 r = pitch * rotZ(-rollRad) * look;
   std::array<double, 9> out{};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      out[static_cast<std::size_t>(3 * i + j)] = r(i, j);
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      out[(3 * i) + j] = r(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
     }
   }
   return out;
@@ -115,10 +115,9 @@ std::array<double, 9> aimedRotation(const Vec3& centre, const Vec3& target, doub
 
 void place(algo::DeviceModel& d, const Vec3& centre, const std::array<double, 9>& r) {
   d.R = r;
-  for (int i = 0; i < 3; ++i) {
-    const auto row = static_cast<std::size_t>(3 * i);
-    d.t[static_cast<std::size_t>(i)] =
-        -((r[row] * centre.x()) + (r[row + 1] * centre.y()) + (r[row + 2] * centre.z()));
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::size_t row = 3 * i;
+    d.t[i] = -((r[row] * centre.x()) + (r[row + 1] * centre.y()) + (r[row + 2] * centre.z()));
   }
 }
 
@@ -234,6 +233,27 @@ std::optional<Placed> placeProjector(Rng& rng, algo::Projector& p, const algo::R
   return Placed{phiDeg, w};
 }
 
+struct Aim {
+  Vec3 hub;  // where the projectors gather: the cameras' mean centre
+  Vec3 target;
+  double phiDeg = 0;
+};
+
+// Draws projector p until a placement fits the envelope.
+std::pair<algo::Projector, Placed> drawPlacedProjector(Rng& rng, const RealismOptions& o,
+                                                       const algo::Rig& rig, const Aim& aim,
+                                                       int p) {
+  constexpr int kAttempts = 1000;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    algo::Projector proj = drawProjector(rng, o, "proj" + std::to_string(p));
+    if (const auto placed = placeProjector(rng, proj, rig, aim.hub, aim.target, aim.phiDeg)) {
+      return {proj, *placed};
+    }
+  }
+  throw std::runtime_error("realism: no placement of projector " + std::to_string(p) +
+                           " fits the envelope");
+}
+
 Vec3 randomColour(Rng& rng, double saturation, double value) {
   // Hue on the RGB hexagon; saturation mixes towards grey of the same value.
   const double h = rng.uniform(0, 6);
@@ -279,7 +299,7 @@ Vec3 plainAlbedo(Rng& rng, bool allowDark) {
 
 struct AlbedoDraw {
   sim::Albedo albedo;
-  const char* kind;
+  const char* kind = "";
 };
 
 AlbedoDraw objectAlbedo(Rng& rng) {
@@ -334,7 +354,9 @@ Meshes loadMeshes() {
 }
 
 // The bunny's bounding-box centre in its own coordinates (y up), metres.
-const Vec3 kBunnyCentre(-0.0168, 0.1100, -0.0016);
+Vec3 bunnyCentre() {
+  return {-0.0168, 0.1100, -0.0016};
+}
 
 // One object centred at `at`, its size scaled by k; returns it and its extent below the centre
 // (+y), metres.
@@ -350,7 +372,7 @@ std::pair<sim::Object, double> drawObject(Rng& rng, const Meshes& meshes, const 
       o.pose.scale = k * rng.uniform(1.2, 2.4);
       // The mesh is y-up: turned upside down about z, then yawed and tipped.
       o.pose.R = rotY(rng.uniform(-70, 70) * kDeg) * rotX(rng.uniform(-15, 15) * kDeg) * rotZ(kPi);
-      o.pose.t = at - (o.pose.R * (o.pose.scale * kBunnyCentre));
+      o.pose.t = at - (o.pose.R * (o.pose.scale * bunnyCentre()));
       below = 0.078 * o.pose.scale;
       break;
     }
@@ -471,19 +493,10 @@ RealismCase generateRealismCase(std::uint64_t seed, int index, const RealismOpti
   }
   for (int p = 0; p < projectors; ++p) {
     const double phi = std::fmod(phis[static_cast<std::size_t>(p)], 180.0);
-    std::optional<Placed> placed;
-    algo::Projector proj;
-    for (int attempt = 0; attempt < 1000 && !placed; ++attempt) {
-      proj = drawProjector(rng, options, "proj" + std::to_string(p));
-      placed = placeProjector(rng, proj, rig, hub, target, phi);
-    }
-    if (!placed) {
-      throw std::runtime_error("realism case " + std::to_string(index) +
-                               ": no projector placement fits the envelope");
-    }
-    rig.projectors.push_back(proj);
-    out.axisDeg.push_back(placed->axisDeg);
-    out.stripeWidthPx.push_back(placed->stripeWidthPx);
+    auto [proj, placed] = drawPlacedProjector(rng, options, rig, {hub, target, phi}, p);
+    rig.projectors.push_back(std::move(proj));
+    out.axisDeg.push_back(placed.axisDeg);
+    out.stripeWidthPx.push_back(placed.stripeWidthPx);
   }
 
   // Objects around T, then what stands behind and under them.
