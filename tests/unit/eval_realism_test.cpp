@@ -251,6 +251,22 @@ TEST(RealismRegions, AggregatesArePixelWeighted) {
   EXPECT_NEAR(s.rmseMm, std::sqrt(((90 * 1.0) + (405 * 4.0)) / 495.0), 1e-12);
 }
 
+// Given a case whose projector 0 has a degenerate pattern (stripes 0 px wide), when it runs, then
+// every camera's run is reported as refused with the pipeline's reason instead of throwing, and
+// the worst-run ranking leaves it out.
+TEST(RealismRuns, ARigThePipelineRefusesIsReportedWithItsReason) {
+  auto c = generateRealismCase(kSeed, 0, {.projectorDistortion = false, .cameraScale = 0.25});
+  c.rig.projectors[0].pattern.stripePx = 0;
+  const auto runs = runRealismCase(c, kSeed, 1);
+  ASSERT_EQ(runs.size(), c.rig.cameras.size());
+  for (const auto& r : runs) {
+    EXPECT_TRUE(r.refused);
+    EXPECT_FALSE(r.reason.empty());
+    EXPECT_EQ(r.lit.regionPixels, 0);
+  }
+  EXPECT_TRUE(worstRuns(runs, 5).empty());
+}
+
 // The fixed-seed CI subset: 20 cases with 320 × 240 cameras, projectors without lens distortion
 // (the pipeline refuses it until projector distortion is supported). The limits are regression
 // guards, not the targets (gross outside the band ≤ 0.1 %, resolvable completeness
