@@ -1,5 +1,5 @@
 // stripemux eval [--out DIR] [--only SECTION,...] [--scene NAME ...] [--seed N]
-//                [--supersampling N]
+//                [--supersampling N] [--cases N] [--no-projector-distortion]
 // The evaluation suite: the named scenes rendered by the simulator, decoded by the firmware's
 // pipeline and scored against the truth; writes DIR/results.md and DIR/results/*.png
 // (docs/results.md is this command's output with the defaults).
@@ -27,6 +27,8 @@ struct EvalOptions {
   std::vector<std::string> scenes;
   std::uint64_t seed = 1;
   int supersampling = 0;
+  int cases = 60;
+  bool noProjectorDistortion = false;
 };
 
 std::string commandLine(const EvalOptions& o) {
@@ -46,6 +48,12 @@ std::string commandLine(const EvalOptions& o) {
   if (o.supersampling != 0) {
     c += " --supersampling " + std::to_string(o.supersampling);
   }
+  if (o.cases != 60) {
+    c += " --cases " + std::to_string(o.cases);
+  }
+  if (o.noProjectorDistortion) {
+    c += " --no-projector-distortion";
+  }
   return c;
 }
 
@@ -53,6 +61,8 @@ int runEval(const EvalOptions& o, const CliStreams& io) {
   eval::SuiteOptions suite;
   suite.seed = o.seed;
   suite.supersampling = o.supersampling;
+  suite.realismCases = o.cases;
+  suite.realism.projectorDistortion = !o.noProjectorDistortion;
   if (!o.only.empty()) {
     suite.sections.clear();
     for (const auto& name : o.only) {
@@ -65,7 +75,7 @@ int runEval(const EvalOptions& o, const CliStreams& io) {
       }
       if (!found) {
         io.err << "stripemux eval: unknown section '" << name
-               << "' (sections: scenes, flat, table2, baselines, sweeps)\n";
+               << "' (sections: scenes, flat, table2, baselines, sweeps, realism)\n";
         return kExitUsage;
       }
     }
@@ -108,7 +118,7 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       "Render the scene suite, decode it and score it against the truth: results.md + plots");
   cmd->add_option("--out", options->out, "Folder for results.md and results/ (default docs)");
   cmd->add_option("--only", options->only,
-                  "Sections to run: scenes, flat, table2, baselines, sweeps (default all)")
+                  "Sections to run: scenes, flat, table2, baselines, sweeps, realism (default all)")
       ->delimiter(',');
   cmd->add_option("--scene", options->scenes,
                   "Only the suite's runs of these named scenes (repeatable)");
@@ -116,6 +126,10 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--supersampling", options->supersampling,
                   "Samples per pixel side of every render (default: the scenes' own, 2)")
       ->check(CLI::Range(1, sim::kMaxSceneSupersampling));
+  cmd->add_option("--cases", options->cases, "Generated scenes of the realism section (default 60)")
+      ->check(CLI::Range(1, 10000));
+  cmd->add_flag("--no-projector-distortion", options->noProjectorDistortion,
+                "Realism section: projectors without lens distortion");
   cmd->callback([options, &io, &exitCode] { exitCode = runEval(*options, io); });
 }
 

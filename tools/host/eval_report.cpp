@@ -11,6 +11,7 @@
 
 #include "output_folder.hpp"
 #include "smx/plots/plots.hpp"
+#include "smx/sim/png_io.hpp"
 
 namespace smx::host {
 namespace {
@@ -385,6 +386,169 @@ struct Writer {
   }
 };
 
+// The targets for the realism suite (fixed seed, the paper's noise).
+constexpr double kTargetGrossAggregate = 0.001;
+constexpr double kTargetGrossEachCase = 0.005;
+constexpr double kTargetResolvableAggregate = 0.95;
+constexpr double kTargetResolvableEachCase = 0.85;
+constexpr double kTargetLitBy3 = 0.90;
+constexpr double kTargetDisparityPx = 0.15;
+// Error maps of the realism suite: the gross-error threshold's order, so that gross errors
+// saturate and sub-millimetre ones still show.
+constexpr double kRealismErrorRangeMm = 5.0;
+
+std::string realismRow(const std::string& head, const std::vector<double>& stripes,
+                       const eval::RealismRun& r) {
+  std::string widths;
+  for (std::size_t p = 0; p < stripes.size(); ++p) {
+    widths += (p == 0 ? "" : " / ") + fixed(stripes[p], 1);
+  }
+  return head + " | " + widths + " | " + completeness(r.lit) + " | " + completeness(r.smooth) +
+         " | " + completeness(r.lit2) + " | " + completeness(r.lit3) + " | " +
+         completeness(r.resolvable) + " | " + pct(r.lit.grossRate, 2) + " | " +
+         pct(r.outsideBand.grossRate, 2) + " | " + fixed(r.lit.rmseMm, 2) + " | " +
+         fixed(r.lit.rmsDisparityPx, 3) + " |\n";
+}
+
+void realismSection(Writer& w, const eval::Report& r) {
+  const auto& s = r.realism;
+  if (s.runs.empty()) {
+    return;
+  }
+  auto& md = w.md;
+  md << "## Realism suite\n\n"
+     << s.cases << " scenes and rigs generated from the seed " << r.seed
+     << " (`tools/host/eval/include/smx/eval/realism_case.hpp` has the envelope: 2–3 projectors "
+        "60–90° apart, 1–2 cameras, baselines 8–25 cm, working distance 0.5–1.2 m, stripes "
+        "3–8 px in the camera there, lens shift and distortion, the bunny, the head and "
+        "primitives before walls and oblique floors, optics from the simulator's ranges), "
+        "projector lens distortion "
+     << (s.generator.projectorDistortion ? "on" : "off") << ", the paper's noise"
+     << Writer::samplingNote(r)
+     << ". Each camera decoded by the firmware's pipeline with its directions predicted at the "
+        "case's working distance; the merged range image scored against the truth "
+        "(`tools/host/eval/include/smx/eval/realism_eval.hpp`). \"resolvable\": smooth lit "
+        "pixels where every lighting projector's stripes are at least "
+     << fixed(eval::kResolvableStripePx, 1)
+     << " px wide in the camera (truth); \"gross outside band\": gross errors among the lit "
+        "pixels farther than "
+     << eval::kDiscontinuityBandPx
+     << " px from a depth discontinuity of the truth. Aggregates are sums of the pixel counts "
+        "over all runs, not means of the ratios.\n\n";
+
+  std::vector<eval::DepthScore> lit;
+  std::vector<eval::DepthScore> smooth;
+  std::vector<eval::DepthScore> lit2;
+  std::vector<eval::DepthScore> lit3;
+  std::vector<eval::DepthScore> resolvable;
+  std::vector<eval::DepthScore> band;
+  int refused = 0;
+  double worstGross = 0;
+  double worstResolvable = 1;
+  int grossOver = 0;
+  int resolvableUnder = 0;
+  for (const auto& run : s.runs) {
+    if (run.refused) {
+      ++refused;
+      continue;
+    }
+    lit.push_back(run.lit);
+    smooth.push_back(run.smooth);
+    lit2.push_back(run.lit2);
+    lit3.push_back(run.lit3);
+    resolvable.push_back(run.resolvable);
+    band.push_back(run.outsideBand);
+    worstGross = std::max(worstGross, run.outsideBand.grossRate);
+    grossOver += run.outsideBand.grossRate > kTargetGrossEachCase ? 1 : 0;
+    if (run.resolvable.regionPixels >= kMinRegionPixels) {
+      worstResolvable = std::min(worstResolvable, run.resolvable.completeness);
+      resolvableUnder += run.resolvable.completeness < kTargetResolvableEachCase ? 1 : 0;
+    }
+  }
+  const auto sLit = eval::sumScores(lit);
+  const auto sSmooth = eval::sumScores(smooth);
+  const auto sLit2 = eval::sumScores(lit2);
+  const auto sLit3 = eval::sumScores(lit3);
+  const auto sResolvable = eval::sumScores(resolvable);
+  const auto sBand = eval::sumScores(band);
+  const std::size_t decoded = s.runs.size() - static_cast<std::size_t>(refused);
+
+  md << "### Aggregate and targets\n\n"
+        "| figure | aggregate | target (aggregate) | worst run | target (every run) | runs "
+        "missing it |\n|---|---|---|---|---|---|\n"
+     << "| gross outside band | " << pct(sBand.grossRate, 3) << " | ≤ "
+     << pct(kTargetGrossAggregate, 1) << " | " << pct(worstGross, 2) << " | ≤ "
+     << pct(kTargetGrossEachCase, 1) << " | " << grossOver << " of " << decoded << " |\n"
+     << "| completeness, resolvable | " << pct(sResolvable.completeness) << " | ≥ "
+     << pct(kTargetResolvableAggregate, 0) << " | " << pct(worstResolvable) << " | ≥ "
+     << pct(kTargetResolvableEachCase, 0) << " | " << resolvableUnder << " of " << decoded << " |\n"
+     << "| completeness, lit by 3 (smooth) | " << completeness(sLit3) << " | ≥ "
+     << pct(kTargetLitBy3, 0) << " (curved surfaces) | | | |\n"
+     << "| RMSE disparity px | " << fixed(sLit.rmsDisparityPx, 3) << " | ≤ "
+     << fixed(kTargetDisparityPx, 2) << " | | | |\n"
+     << "| completeness, all lit | " << completeness(sLit) << " | | | | |\n"
+     << "| completeness, smooth | " << completeness(sSmooth) << " | | | | |\n"
+     << "| completeness, lit by 2 (smooth) | " << completeness(sLit2) << " | | | | |\n"
+     << "| gross, all lit | " << pct(sLit.grossRate, 2) << " | | | | |\n"
+     << "| RMSE mm | " << fixed(sLit.rmseMm, 2) << " | | | | |\n"
+     << "| runs refused by the pipeline | " << refused << " of " << s.runs.size()
+     << " | | | | |\n\n";
+
+  md << "### Per run\n\n"
+        "Rig: per projector the baseline to this camera, its encoding axis in cam0 and the "
+        "designed stripe width in cam0 at the working distance; stripe px: the median width in "
+        "this camera over the pixels each projector lights (truth).\n\n"
+        "| case | cam | scene | rig | stripe px | completeness, all lit | smooth | lit by 2 | "
+        "lit by 3 | resolvable | gross | gross outside band | RMSE mm | RMSE disparity px |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& run : s.runs) {
+    const std::string head = "| " + std::to_string(run.caseIndex) + " | cam" +
+                             std::to_string(run.camera) + " | " + run.summary + " | " + run.rig;
+    if (run.refused) {
+      md << head << " | refused: " << run.reason << " | | | | | | | | | |\n";
+    } else {
+      md << realismRow(head, run.medianStripePx, run);
+    }
+  }
+  md << realismRow("| **all** | | | " + std::to_string(decoded) + " runs", {}, [&] {
+    eval::RealismRun t;
+    t.lit = sLit;
+    t.smooth = sSmooth;
+    t.lit2 = sLit2;
+    t.lit3 = sLit3;
+    t.resolvable = sResolvable;
+    t.outsideBand = sBand;
+    return t;
+  }());
+
+  md << "\n### The " << eval::kRealismWorstShown
+     << " worst runs (gross errors outside the band)\n\n"
+        "Camera image, then merged depth − truth, ±"
+     << fixed(kRealismErrorRangeMm, 0)
+     << " mm full scale (blue nearer, red farther); grey: no "
+        "depth.\n\n";
+  for (const auto* run : eval::worstRuns(s.runs, eval::kRealismWorstShown)) {
+    if (run->errorMm.empty()) {
+      continue;
+    }
+    const std::string id =
+        "case" + std::to_string(run->caseIndex) + "_cam" + std::to_string(run->camera);
+    md << "- case " << run->caseIndex << ", cam" << run->camera << " (" << run->summary
+       << "): gross outside band " << pct(run->outsideBand.grossRate, 2) << ", resolvable "
+       << completeness(run->resolvable) << "\n\n";
+    w.plot("realism_" + id + ".png",
+           [&](const fs::path& f) { return sim::writePngRgb8(f, run->image.view()); });
+    w.plot("realism_error_" + id + ".png", [&](const fs::path& f) {
+      return plots::writeErrorMap(f, run->errorMm, run->image.width, run->image.height,
+                                  kRealismErrorRangeMm, "realism " + id);
+    });
+    w.image("realism " + id + " camera", "realism_" + id + ".png");
+    w.image("realism " + id + " error map", "realism_error_" + id + ".png");
+    md << "\n";
+  }
+  md << "\n";
+}
+
 // Plots of an earlier run that this one did not make must not linger; other files stay.
 void removeStalePlots(const fs::path& results, const std::set<std::string>& written) {
   std::error_code ec;
@@ -392,7 +556,7 @@ void removeStalePlots(const fs::path& results, const std::set<std::string>& writ
     const std::string name = entry.path().filename().string();
     if (entry.path().extension() == ".png" && !written.contains(name) &&
         (name.starts_with("error_") || name.starts_with("sweep_") || name.starts_with("table2") ||
-         name == "completeness.png")) {
+         name.starts_with("realism_") || name == "completeness.png")) {
       fs::remove(entry.path(), ec);
     }
   }
@@ -428,6 +592,7 @@ std::expected<void, std::string> writeEvalReport(const fs::path& dir, const eval
   w.table2(report);
   w.baselines(report);
   w.sweeps(report);
+  realismSection(w, report);
   if (!w.error.empty()) {
     return std::unexpected(w.error);
   }

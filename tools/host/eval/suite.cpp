@@ -276,6 +276,29 @@ struct Runner {
     return *mid;
   }
 
+  // Generated cases, not named scenes: skipped when the run asks for named scenes only.
+  void realism() {
+    if (!options.scenes.empty()) {
+      return;
+    }
+    report.realism.cases = options.realismCases;
+    report.realism.generator = options.realism;
+    for (int i = 0; i < options.realismCases; ++i) {
+      const auto start = Clock::now();
+      const RealismCase c = generateRealismCase(options.seed, i, options.realism);
+      auto runs = runRealismCase(c, options.seed, options.supersampling);
+      std::string what = "realism case " + std::to_string(i) + " (" + c.summary + ")";
+      for (auto& r : runs) {
+        if (r.refused) {
+          what += ", cam" + std::to_string(r.camera) + " refused: " + r.reason;
+        }
+        report.realism.runs.push_back(std::move(r));
+      }
+      keepWorstImages(report.realism.runs, kRealismWorstShown);
+      note(what, start);
+    }
+  }
+
   void sweep(Sweep s, const std::vector<double>& values,
              const std::function<void(double, algo::Rig&, sim::Scene&)>& apply) {
     const auto baseRig = loadExampleRig("rig_2proj_1cam.json");
@@ -332,8 +355,8 @@ struct Runner {
 }  // namespace
 
 std::vector<Section> allSections() {
-  return {Section::kScenes, Section::kFlat, Section::kTable2, Section::kBaselines,
-          Section::kSweeps};
+  return {Section::kScenes,    Section::kFlat,   Section::kTable2,
+          Section::kBaselines, Section::kSweeps, Section::kRealism};
 }
 
 const char* sectionName(Section section) {
@@ -348,6 +371,8 @@ const char* sectionName(Section section) {
       return "baselines";
     case Section::kSweeps:
       return "sweeps";
+    case Section::kRealism:
+      return "realism";
   }
   return "?";
 }
@@ -374,6 +399,9 @@ Report runSuite(const SuiteOptions& options) {
         break;
       case Section::kSweeps:
         runner.sweeps();
+        break;
+      case Section::kRealism:
+        runner.realism();
         break;
     }
   }

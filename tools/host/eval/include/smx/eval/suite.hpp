@@ -9,6 +9,8 @@
 #include "smx/eval/boundary_eval.hpp"
 #include "smx/eval/depth_eval.hpp"
 #include "smx/eval/frame_eval.hpp"
+#include "smx/eval/realism_case.hpp"
+#include "smx/eval/realism_eval.hpp"
 #include "smx/eval/sim_frame.hpp"
 #include "smx/eval/table2.hpp"
 
@@ -76,6 +78,15 @@ struct Sweep {
   std::vector<SweepPoint> points;
 };
 
+// The randomised realism suite (realism_case.hpp, realism_eval.hpp): one run per camera of each
+// generated case; the camera image and error map are kept for the kRealismWorstShown worst runs.
+inline constexpr int kRealismWorstShown = 5;
+struct RealismReport {
+  int cases = 0;
+  RealismOptions generator;
+  std::vector<RealismRun> runs;
+};
+
 struct Report {
   std::uint64_t seed = 1;
   int supersampling = 0;
@@ -87,10 +98,11 @@ struct Report {
   std::vector<BoundaryRun> directColour;
   std::vector<TrueDirectionRun> trueDirections;
   std::vector<Sweep> sweeps;
+  RealismReport realism;
   double seconds = 0;
 };
 
-enum class Section : std::uint8_t { kScenes, kFlat, kTable2, kBaselines, kSweeps };
+enum class Section : std::uint8_t { kScenes, kFlat, kTable2, kBaselines, kSweeps, kRealism };
 [[nodiscard]] std::vector<Section> allSections();
 [[nodiscard]] const char* sectionName(Section section);
 
@@ -98,7 +110,9 @@ struct SuiteOptions {
   std::uint64_t seed = 1;
   int supersampling = 0;  // samples per pixel side of every render; 0: the scenes' own (2)
   std::vector<Section> sections = allSections();
-  std::vector<std::string> scenes;                   // empty: every scene of the suite
+  std::vector<std::string> scenes;  // empty: every scene of the suite
+  int realismCases = 60;            // generated cases of the realism section
+  RealismOptions realism;
   std::function<void(const std::string&)> progress;  // one line per finished run
 };
 
