@@ -453,6 +453,34 @@ void drawOptics(Rng& rng, sim::Scene& s, double distanceM) {
   s.camera.crosstalk = c;
 }
 
+// The simulator's realism fields (docs/simulator.md): finite projector contrast and display
+// gamma, the camera's response curve, vignetting and colour mosaic, motion blur of slowly moving
+// objects over the exposure, and gloss. Sets exactly these fields.
+void drawRealOptics(Rng& rng, sim::Scene& s) {
+  s.lighting.projectorBlackLevel = rng.uniform(0.001, 0.02);
+  s.lighting.projectorGamma = rng.uniform(1.8, 2.4);
+  s.camera.responseGamma = rng.uniform(1.0, 2.2);
+  s.camera.vignetting = rng.uniform(0, 0.4);
+  constexpr std::array<const char*, 5> kMosaics = {"none", "rggb", "bggr", "grbg", "gbrg"};
+  s.camera.bayer = kMosaics[static_cast<std::size_t>(rng.below(5))];
+  s.camera.exposure = rng.uniform(0, 0.5);
+  s.camera.exposureSamples = 4;
+  for (auto& o : s.objects) {
+    if (o.name == "wall" || o.name == "floor") {
+      continue;
+    }
+    // Handheld drift: up to 2 mm and 0.3° per frame, about 1 px of blur over the exposure.
+    o.motion.velocityMPerFrame =
+        Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized() *
+        rng.uniform(0, 0.002);
+    o.motion.axis = Vec3::UnitY();
+    o.motion.pivot = o.pose.t;
+    o.motion.angularDegPerFrame = rng.uniform(-0.3, 0.3);
+    o.albedo.specular = rng.uniform(0, 0.3);
+    o.albedo.shininess = rng.uniform(10, 200);
+  }
+}
+
 std::string fixed2(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f", v);
@@ -542,6 +570,7 @@ RealismCase generateRealismCase(std::uint64_t seed, int index, const RealismOpti
     behind += behind.empty() ? "floor" : " + floor";
   }
   drawOptics(rng, scene, d);
+  drawRealOptics(rng, scene);
 
   out.summary = std::to_string(projectors) + "P" + std::to_string(cameras) + "C, " + fixed2(d) +
                 " m; " + names + "; " + behind;

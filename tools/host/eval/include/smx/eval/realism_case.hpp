@@ -32,7 +32,9 @@
 //   scales, a background wall (tilted up to 25°) and/or an oblique floor under the objects;
 //   albedo grey, coloured, saturated, dark or checker-textured; optics from the ranges of
 //   docs/simulator.md (the paper's noise, ambient, projector power with 1/d², defocus of projector
-//   and camera, colour crosstalk, gain).
+//   and camera, colour crosstalk, gain, projector black level 0.1–2 % and gamma 1.8–2.4, camera
+//   response gamma 1–2.2, vignetting up to 40 %, a Bayer mosaic, motion blur over an exposure of
+//   up to half a frame, gloss up to 0.3).
 namespace smx::eval {
 
 struct RealismOptions {
