@@ -98,17 +98,17 @@ Result<void> trustDepth(const Triangulator& triangulator, ConstStripePlane strip
         z[x] = kNoDepth;
         continue;
       }
-      const std::int64_t e = (gradient * params.boundaryErrorQ8 + 128) >> 8;
-      const std::int64_t ahead = s + e;
-      const std::uint16_t zPlus = ahead < Triangulator::kMaxStripe
-                                      ? triangulator.depthAt(x, y, static_cast<StripeQ16>(ahead))
-                                      : kNoDepth;
-      const std::uint16_t zMinus = triangulator.depthAt(x, y, static_cast<StripeQ16>(s - e));
-      if (zPlus == kNoDepth || zMinus == kNoDepth) {
+      // One-sided: z(s) is the pixel's depth already, and the second triangulation of the
+      // central difference would cost as much again for a second-order difference.
+      const std::int64_t ahead = s + ((gradient * params.boundaryErrorQ8 + 128) >> 8);
+      const std::uint16_t zAhead = ahead < Triangulator::kMaxStripe
+                                       ? triangulator.depthAt(x, y, static_cast<StripeQ16>(ahead))
+                                       : kNoDepth;
+      if (zAhead == kNoDepth) {
         z[x] = kNoDepth;
         continue;
       }
-      const std::int64_t spread = zPlus > zMinus ? zPlus - zMinus : zMinus - zPlus;
+      const std::int64_t spread = std::int64_t{2} * (zAhead > z[x] ? zAhead - z[x] : z[x] - zAhead);
       c[x] = confidenceOf(spread, z[x], params);
       if (c[x] == 0) {
         z[x] = kNoDepth;

@@ -59,13 +59,30 @@ constexpr std::array<std::int32_t, kMaxRanges + 1> kInverseSqrtQ8 = {256, 256, 1
 std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std::size_t n,
                         const DepthTolerance& tolerance) {
   int present = 0;
+  std::uint16_t first = kNoDepth;
+  for (std::size_t i = 0; i < n; ++i) {
+    present += centre[i] != kNoDepth ? 1 : 0;
+    first = first == kNoDepth ? centre[i] : first;
+  }
+  if (present <= 1) {
+    return first;  // one range alone passes (or none: no depth)
+  }
+  // Usually every value agrees with the first: then it has all the support.
+  const std::int32_t firstTol = tolerance.at(first);
+  bool all = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t d = std::int32_t{centre[i]} - first;
+    all = all && (centre[i] == kNoDepth || (d < 0 ? -d : d) <= firstTol);
+  }
+  if (all) {
+    return first;
+  }
   int bestSupport = 0;
   std::uint16_t best = kNoDepth;
   for (std::size_t i = 0; i < n; ++i) {
     if (centre[i] == kNoDepth) {
       continue;
     }
-    ++present;
     const std::int32_t tol = tolerance.at(centre[i]);
     int support = 0;
     for (std::size_t j = 0; j < n; ++j) {
@@ -132,10 +149,12 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
       if (ref == kNoDepth) {
         continue;
       }
+      // z within [ref − tol, ref + tol] and not kNoDepth, in one unsigned comparison.
       const std::int32_t tol = tolerance.at(ref);
-      const auto agrees = [ref, tol](std::uint16_t z) {
-        const std::int32_t d = std::int32_t{z} - ref;
-        return z != kNoDepth && (d < 0 ? -d : d) <= tol;
+      const std::int32_t low = ref > tol ? ref - tol : 1;
+      const auto span = static_cast<std::uint32_t>(ref + tol - low);
+      const auto agrees = [low, span](std::uint16_t z) {
+        return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
       };
       const int x0 = x > 0 ? x - 1 : 0;
       const int x1 = x + 1 < w ? x + 1 : w - 1;

@@ -16,8 +16,9 @@
 //     one-sided where a neighbour has no coordinate; none on an axis: no depth), its magnitude as
 //     max(a, 7/8·a + 1/2·b) with a ≥ b the axes' magnitudes (within 4 % of the Euclidean norm);
 //   - resolvable: 1 / |∇s| ≥ minStripeWidthQ8 / 256 px;
-//   - predicted error: e = |z(s + |∇s|·δ) − z(s − |∇s|·δ)| / 2 with δ = boundaryErrorQ8 / 256 px
-//     (Triangulator::depthAt twice: exact for the tables), kept when errorMargin · e ≤ tol(z),
+//   - predicted error: e = |z(s + |∇s|·δ) − z(s)| with δ = boundaryErrorQ8 / 256 px
+//     (Triangulator::depthAt once more: exact for the tables; the central difference would
+//     differ only in second order), kept when errorMargin · e ≤ tol(z),
 //     tol(z) = max(minUnits, permille ‰ of z), the gross tolerance;
 //   - confidence 255 · (1 − errorMargin · e / tol(z)), clamped to 1…255 (0: no depth).
 // The defaults and where they come from: docs/decode.md, "Trust and confidence".
