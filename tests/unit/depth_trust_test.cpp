@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -231,6 +232,46 @@ TEST(DepthTrust, ATiltedPlaneWithTwoPixelStripesGivesNoWrongDepth) {
   EXPECT_GE(fig.pairs[1].completeness, 0.95);
   EXPECT_LE(fig.mergedAll.grossRate, 0.001);
   EXPECT_GE(fig.mergedAll.completeness, 0.85);
+}
+
+// The merged confidence against the truth on the sphere and the bunny: 0 exactly where there is
+// no depth, and the depths with a high confidence are nearer the truth than those with a low one.
+TEST(DepthTrust, MergedConfidenceFollowsTheTrueError) {
+  const int kSplit = 230;  // most merged depths lie between 200 and 240 on these scenes
+  for (const char* scene : {"sphere", "bunny"}) {
+    const auto f = eval::renderSimFrame({"rig_2proj_1cam.json", scene});
+    const auto run = eval::runPipeline(f, 0);
+    const auto z = run->pipeline->merged();
+    const auto c = run->pipeline->confidence();
+    const double unitMm = kDefaultDepthUnitM * 1000;
+    std::array<double, 2> sum{};
+    std::array<int, 2> count{};
+    for (int y = 0; y < f.image.height; ++y) {
+      for (int x = 0; x < f.image.width; ++x) {
+        const std::uint16_t depth = z.rowPtr(y)[x];
+        const std::uint8_t confidence = c.rowPtr(y)[x];
+        ASSERT_EQ(depth == kNoDepth, confidence == 0) << scene << " at " << x << "," << y;
+        const float truth = f.depth.at(x, y);
+        if (depth == kNoDepth || !std::isfinite(truth)) {
+          continue;
+        }
+        const double errorMm = depth * unitMm - truth * 1000.0;
+        if (std::abs(errorMm) > 5.0) {
+          continue;  // gross: the RMSE's business is the rest
+        }
+        const auto bin = static_cast<std::size_t>(confidence >= kSplit ? 1 : 0);
+        sum[bin] += errorMm * errorMm;
+        ++count[bin];
+      }
+    }
+    ASSERT_GT(count[0], 1000) << scene;
+    ASSERT_GT(count[1], 1000) << scene;
+    const double low = std::sqrt(sum[0] / count[0]);
+    const double high = std::sqrt(sum[1] / count[1]);
+    std::printf("%s: RMSE %.3f mm below confidence %d (%d px), %.3f mm from it (%d px)\n", scene,
+                low, kSplit, count[0], high, count[1]);
+    EXPECT_LT(high, low) << scene;
+  }
 }
 
 TEST(DepthTrust, RejectsParametersNamingTheField) {
