@@ -1,4 +1,6 @@
 // Init time: the camera pipeline's tables from the rig.
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "smx/algo/camera_pipeline.hpp"
@@ -29,6 +31,12 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
     }
     setup.triangulation.push_back(std::move(*tables));
   }
+  if (!(options.depthUnitM > 0.0) || !std::isfinite(options.depthUnitM)) {
+    return std::unexpected("pipeline: the depth unit must be positive");
+  }
+  setup.trust = options.trust;
+  setup.trust.tolerance.minUnits =
+      static_cast<int>(std::clamp(std::ceil(kGrossToleranceM / options.depthUnitM), 1.0, 65535.0));
   return setup;
 }
 

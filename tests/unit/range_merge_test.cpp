@@ -1,12 +1,14 @@
 // The paper's median-variant merge (range_merge.hpp) on hand-worked windows, each built so that a
 // plausible wrong rule gives another answer, and against a plain reference over random planes;
-// the depth-edge filter (depth_edges.hpp) that runs before it.
+// the consistency vote before it on synthetic range planes with known depth (one projector
+// offset in a patch); the depth-edge filter (depth_edges.hpp) that runs before the merge.
 #include "smx/algo/range_merge.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <initializer_list>
 #include <random>
 #include <vector>
@@ -29,7 +31,11 @@ struct Plane {
   [[nodiscard]] ConstDepthPlane view() const { return *ConstDepthPlane::packed(z, width, height); }
 };
 
-// The merged value at (x, y) of the given range images.
+// Every value agrees with every other: the paper's filter alone, as the hand-worked windows
+// below (whose values lie far apart) need.
+constexpr DepthTolerance kPaperOnly{65535, 0};
+
+// The merged value at (x, y) of the given range images, the paper's filter alone.
 std::uint16_t mergedAt(const std::vector<const Plane*>& inputs, int x = 1, int y = 1) {
   std::vector<ConstDepthPlane> views;
   for (const Plane* p : inputs) {
@@ -38,7 +44,7 @@ std::uint16_t mergedAt(const std::vector<const Plane*>& inputs, int x = 1, int y
   const int w = inputs[0]->width;
   const int h = inputs[0]->height;
   std::vector<std::uint16_t> out(static_cast<std::size_t>(w * h), 7);
-  EXPECT_TRUE(mergeRanges(views, *DepthPlane::packed(out, w, h)));
+  EXPECT_TRUE(mergeRanges(views, *DepthPlane::packed(out, w, h), kPaperOnly));
   return out[static_cast<std::size_t>(y * w + x)];
 }
 
@@ -118,6 +124,13 @@ TEST(RangeMerge, RejectsMismatchedSizesAndCounts) {
   EXPECT_FALSE(mergeRanges({}, *DepthPlane::packed(out, 3, 3)));
   const std::vector<ConstDepthPlane> nine(9, a.view());
   EXPECT_FALSE(mergeRanges(nine, *DepthPlane::packed(out, 3, 3)));
+  const std::vector<ConstDepthPlane> two = {a.view(), a.view()};
+  std::vector<std::uint8_t> conf(9);
+  const std::vector<ImageView<const std::uint8_t>> oneConfidence = {
+      *ImageView<const std::uint8_t>::packed(conf, 3, 3)};
+  EXPECT_FALSE(mergeRanges(two, oneConfidence, *DepthPlane::packed(out, 3, 3),
+                           *ImageView<std::uint8_t>::packed(conf, 3, 3)));
+  EXPECT_FALSE(mergeRanges(two, *DepthPlane::packed(out, 3, 3), DepthTolerance{50, 1001}));
 }
 
 // A plain reference: sets as vectors, variances from the deviations (not the sums of squares)
@@ -191,6 +204,8 @@ std::uint16_t reference(const std::vector<std::vector<std::uint16_t>>& planes, i
   return static_cast<std::uint16_t>(m);
 }
 
+// With the default tolerance (5 mm = 50 units) depths 5000…5040 all agree: the vote changes
+// nothing and the output is the paper's filter's.
 TEST(RangeMerge, MatchesAPlainReferenceOnRandomSparsePlanesWithoutTouchingTheHeap) {
   std::mt19937 rng(11);
   const int w = 37;
@@ -222,6 +237,135 @@ TEST(RangeMerge, MatchesAPlainReferenceOnRandomSparsePlanesWithoutTouchingTheHea
       }
     }
   }
+}
+
+// Synthetic range planes of a sloped surface with known depth (units of 0.1 mm, about 0.9 m) and
+// ±3 units of noise; `offset` is added inside the patch [10, 20) × [8, 16) of the chosen planes.
+struct Scene {
+  static constexpr int kW = 32;
+  static constexpr int kH = 24;
+  std::vector<std::vector<std::uint16_t>> planes;
+
+  [[nodiscard]] static int truth(int x, int y) { return 9000 + 3 * x + 2 * y; }
+  [[nodiscard]] static bool inPatch(int x, int y) { return x >= 10 && x < 20 && y >= 8 && y < 16; }
+
+  Scene(int count, const std::vector<int>& offsetPlanes, int offset) {
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> noise(-3, 3);
+    for (int p = 0; p < count; ++p) {
+      std::vector<std::uint16_t> z(static_cast<std::size_t>(kW * kH));
+      const bool offsetHere =
+          std::find(offsetPlanes.begin(), offsetPlanes.end(), p) != offsetPlanes.end();
+      for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+          const int shift = offsetHere && inPatch(x, y) ? offset : 0;
+          z[static_cast<std::size_t>(y * kW + x)] =
+              static_cast<std::uint16_t>(truth(x, y) + noise(rng) + shift);
+        }
+      }
+      planes.push_back(std::move(z));
+    }
+  }
+  [[nodiscard]] std::vector<std::uint16_t> merge() const {
+    std::vector<ConstDepthPlane> views;
+    for (const auto& p : planes) {
+      views.push_back(*ConstDepthPlane::packed(p, kW, kH));
+    }
+    std::vector<std::uint16_t> out(static_cast<std::size_t>(kW * kH), 7);
+    EXPECT_TRUE(mergeRanges(views, *DepthPlane::packed(out, kW, kH)));
+    return out;
+  }
+};
+
+// A merged value is right when it is within the noise and the 3×3 window's slope of the truth
+// (3 + 3 + 2 units); a blend of the 3 cm offset (300 units) into a median of at most 27 values
+// moves it further, the offset itself by 300.
+constexpr int kWindowSpread = 8;
+
+// Three projectors, the third 3 cm off in the patch: the two that agree outvote it, everywhere.
+TEST(RangeMerge, TwoAgreeingRangesOutvoteAThirdOffsetByThreeCentimetres) {
+  const Scene scene(3, {2}, 300);
+  const auto out = scene.merge();
+  for (int y = 0; y < Scene::kH; ++y) {
+    for (int x = 0; x < Scene::kW; ++x) {
+      const int z = out[static_cast<std::size_t>(y * Scene::kW + x)];
+      ASSERT_NE(z, kNoDepth) << x << "," << y;
+      EXPECT_LE(std::abs(z - Scene::truth(x, y)), kWindowSpread) << x << "," << y;
+    }
+  }
+}
+
+// Two projectors that disagree in the patch: no depth there rather than a guess; outside it the
+// depth is right, also in the ring where the window reaches into the patch.
+TEST(RangeMerge, TwoRangesThatDisagreeGiveNoDepth) {
+  for (const int offset : {300, -300, 110}) {  // 11 mm: beyond the tolerance, 1 % of z ≈ 9.1 mm
+    const Scene scene(2, {1}, offset);
+    const auto out = scene.merge();
+    for (int y = 0; y < Scene::kH; ++y) {
+      for (int x = 0; x < Scene::kW; ++x) {
+        const int z = out[static_cast<std::size_t>(y * Scene::kW + x)];
+        if (Scene::inPatch(x, y)) {
+          EXPECT_EQ(z, kNoDepth) << offset << " at " << x << "," << y;
+        } else {
+          EXPECT_LE(std::abs(z - Scene::truth(x, y)), kWindowSpread)
+              << offset << " at " << x << "," << y;
+        }
+      }
+    }
+  }
+}
+
+// Where one projector alone lights the surface its range passes, offset or not (the trust filter
+// is what judges a pair on its own), and a neighbouring range that disagrees does not leak in.
+TEST(RangeMerge, ARangeAlonePassesAndDisagreeingNeighboursStayOut) {
+  Scene scene(2, {1}, 300);
+  for (int y = 0; y < Scene::kH; ++y) {
+    for (int x = 0; x < 15; ++x) {
+      scene.planes[0][static_cast<std::size_t>(y * Scene::kW + x)] = kNoDepth;  // 1 alone
+    }
+  }
+  const auto out = scene.merge();
+  for (int y = 0; y < Scene::kH; ++y) {
+    for (int x = 0; x < Scene::kW; ++x) {
+      const int z = out[static_cast<std::size_t>(y * Scene::kW + x)];
+      const int expected = Scene::truth(x, y) + (x < 15 && Scene::inPatch(x, y) ? 300 : 0);
+      if (x >= 15 && Scene::inPatch(x, y)) {
+        EXPECT_EQ(z, kNoDepth) << x << "," << y;
+      } else {
+        EXPECT_LE(std::abs(z - expected), kWindowSpread) << x << "," << y;
+      }
+    }
+  }
+}
+
+// The merged confidence: the best agreeing range's predicted error divided by √k, 0 without
+// depth. 3×3 planes, the values at the centre.
+TEST(RangeMerge, ConfidenceRisesWhenRangesAgreeAndIsZeroWithoutDepth) {
+  const auto at = [](const std::vector<std::uint16_t>& zs, const std::vector<std::uint8_t>& cs) {
+    std::vector<std::vector<std::uint16_t>> planes;
+    std::vector<std::vector<std::uint8_t>> conf;
+    for (std::size_t i = 0; i < zs.size(); ++i) {
+      planes.emplace_back(9, zs[i]);
+      conf.emplace_back(9, cs[i]);
+    }
+    std::vector<ConstDepthPlane> views;
+    std::vector<ImageView<const std::uint8_t>> confViews;
+    for (std::size_t i = 0; i < zs.size(); ++i) {
+      views.push_back(*ConstDepthPlane::packed(planes[i], 3, 3));
+      confViews.push_back(*ImageView<const std::uint8_t>::packed(conf[i], 3, 3));
+    }
+    std::vector<std::uint16_t> out(9);
+    std::vector<std::uint8_t> outConf(9, 7);
+    EXPECT_TRUE(mergeRanges(views, confViews, *DepthPlane::packed(out, 3, 3),
+                            *ImageView<std::uint8_t>::packed(outConf, 3, 3)));
+    return static_cast<int>(outConf[4]);
+  };
+  EXPECT_EQ(at({9000}, {200}), 200);                             // alone: its own
+  EXPECT_EQ(at({9000, 9010}, {200, 150}), 255 - 39);             // 55 · 181 / 256 = 38.9
+  EXPECT_EQ(at({9000, 9010, 8990}, {200, 150, 100}), 255 - 32);  // 55 · 148 / 256 = 31.8
+  EXPECT_EQ(at({9000, 9300, 9010}, {200, 255, 150}), 255 - 39);  // the outvoted one counts not
+  EXPECT_EQ(at({9000, 9300}, {200, 255}), 0);                    // disagreeing: no depth
+  EXPECT_EQ(at({0, 9000}, {0, 1}), 1);                           // never 0 where depth is
 }
 
 // The depth-edge filter: a 5×3 image with a step from 1000 to 1100 units (10 %) between columns

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "smx/algo/depth_edges.hpp"
+#include "smx/algo/depth_trust.hpp"
 #include "smx/algo/range_merge.hpp"
 
 namespace smx::algo {
@@ -17,6 +18,9 @@ Result<void> validate(const CameraPipelineSetup& s) {
   }
   if (s.edgeJumpPermille < 0 || s.edgeJumpPermille > 1000) {
     return fail(Errc::kInvalidArgument, "pipeline: edgeJumpPermille 0 to 1000");
+  }
+  if (auto ok = validateDepthTrust(s.trust); !ok) {
+    return ok;
   }
   if (s.triangulation.size() != static_cast<std::size_t>(s.layout.projectors)) {
     return fail(Errc::kSizeMismatch, "pipeline: one triangulation table per projector");
@@ -41,8 +45,10 @@ Result<void> CameraPipeline::carve(Carver& carver) {
     step(carveImage(carver, stripes_[i], w, h));
     step(carveImage(carver, levels_[i], w, h));
     step(carveImage(carver, depths_[i], w, h));
+    step(carveImage(carver, confidences_[i], w, h));
   }
   step(carveImage(carver, merged_, w, h));
+  step(carveImage(carver, mergedConfidence_, w, h));
   return ok;
 }
 
@@ -86,6 +92,7 @@ Result<CameraPipeline> CameraPipeline::create(const CameraPipelineSetup& setup, 
   CameraPipeline c;
   c.layout_ = setup.layout;
   c.edgeJumpPermille_ = setup.edgeJumpPermille;
+  c.trust_ = setup.trust;
   auto demux = Demultiplexer::create(setup.layout, setup.predictedAngles, arena);
   if (!demux) {
     return undo(demux.error());
@@ -150,7 +157,11 @@ Result<void> CameraPipeline::triangulate() {
       return fail(Errc::kInvalidArgument, "pipeline: not created");
     }
     // The merged plane is free until merge(): the unfiltered range image goes there first.
+    // Untrusted depths go before the edge filter, so that they cannot cut good neighbours.
     if (auto ok = triangulator->run(stripes_[i], merged_); !ok) {
+      return ok;
+    }
+    if (auto ok = trustDepth(*triangulator, stripes_[i], merged_, confidences_[i], trust_); !ok) {
       return ok;
     }
     if (auto ok = removeDepthEdges(merged_, depths_[i], edgeJumpPermille_); !ok) {
@@ -162,12 +173,15 @@ Result<void> CameraPipeline::triangulate() {
 
 Result<void> CameraPipeline::merge() {
   std::array<ConstDepthPlane, kMaxProjectors> inputs{};
+  std::array<ImageView<const std::uint8_t>, kMaxProjectors> confidences{};
   for (std::size_t i = 0; i < static_cast<std::size_t>(layout_.projectors); ++i) {
     inputs[i] = depths_[i];
+    confidences[i] = confidences_[i];
   }
-  return mergeRanges(
-      std::span<const ConstDepthPlane>(inputs.data(), static_cast<std::size_t>(layout_.projectors)),
-      merged_);
+  const auto n = static_cast<std::size_t>(layout_.projectors);
+  return mergeRanges(std::span<const ConstDepthPlane>(inputs.data(), n),
+                     std::span<const ImageView<const std::uint8_t>>(confidences.data(), n), merged_,
+                     mergedConfidence_, trust_.tolerance);
 }
 
 Result<void> CameraPipeline::run(ConstRgbView image) {
@@ -197,6 +211,12 @@ ConstDepthPlane CameraPipeline::depth(int projector) const {
 }
 ConstDepthPlane CameraPipeline::merged() const {
   return merged_;
+}
+ImageView<const std::uint8_t> CameraPipeline::confidence(int projector) const {
+  return confidences_[static_cast<std::size_t>(projector)];
+}
+ImageView<const std::uint8_t> CameraPipeline::confidence() const {
+  return mergedConfidence_;
 }
 
 }  // namespace smx::algo

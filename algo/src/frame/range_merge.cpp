@@ -50,11 +50,61 @@ std::uint16_t median(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
   return static_cast<std::uint16_t>((std::uint32_t{v[mid - 1]} + v[mid] + 1) / 2);
 }
 
-}  // namespace
+// 256 / √k, rounded: the predicted error of the mean of k agreeing ranges (Q8), k = 0…8.
+constexpr std::array<std::int32_t, kMaxRanges + 1> kInverseSqrtQ8 = {256, 256, 181, 148, 128,
+                                                                     114, 105, 97,  91};
 
-Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out) {
+// The reference value at a pixel from the ranges' centre values (0: none), or 0 when no value
+// has a strict majority within the tolerance.
+std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std::size_t n,
+                        const DepthTolerance& tolerance) {
+  int present = 0;
+  std::uint16_t first = kNoDepth;
+  for (std::size_t i = 0; i < n; ++i) {
+    present += centre[i] != kNoDepth ? 1 : 0;
+    first = first == kNoDepth ? centre[i] : first;
+  }
+  if (present <= 1) {
+    return first;  // one range alone passes (or none: no depth)
+  }
+  // Usually every value agrees with the first: then it has all the support.
+  const std::int32_t firstTol = tolerance.at(first);
+  bool all = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t d = std::int32_t{centre[i]} - first;
+    all = all && (centre[i] == kNoDepth || (d < 0 ? -d : d) <= firstTol);
+  }
+  if (all) {
+    return first;
+  }
+  int bestSupport = 0;
+  std::uint16_t best = kNoDepth;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (centre[i] == kNoDepth) {
+      continue;
+    }
+    const std::int32_t tol = tolerance.at(centre[i]);
+    int support = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::int32_t d = std::int32_t{centre[j]} - centre[i];
+      support += centre[j] != kNoDepth && (d < 0 ? -d : d) <= tol ? 1 : 0;
+    }
+    if (support > bestSupport) {
+      bestSupport = support;
+      best = centre[i];
+    }
+  }
+  return 2 * bestSupport > present ? best : kNoDepth;
+}
+
+Result<void> merge(std::span<const ConstDepthPlane> ranges,
+                   std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
+                   ImageView<std::uint8_t>* outConfidence, const DepthTolerance& tolerance) {
   if (ranges.empty() || ranges.size() > static_cast<std::size_t>(kMaxRanges)) {
     return fail(Errc::kInvalidArgument, "merge: 1 to 8 range images");
+  }
+  if (tolerance.minUnits < 0 || tolerance.permille < 0 || tolerance.permille > 1000) {
+    return fail(Errc::kInvalidArgument, "merge: tolerance minUnits >= 0, permille 0 to 1000");
   }
   const int w = out.width();
   const int h = out.height();
@@ -63,33 +113,70 @@ Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out
       return fail(Errc::kSizeMismatch, "merge: range images must have the output's size");
     }
   }
+  if (outConfidence != nullptr) {
+    if (confidences.size() != ranges.size()) {
+      return fail(Errc::kSizeMismatch, "merge: one confidence plane per range image");
+    }
+    if (outConfidence->width() != w || outConfidence->height() != h) {
+      return fail(Errc::kSizeMismatch, "merge: confidence planes must have the output's size");
+    }
+    for (const ImageView<const std::uint8_t>& c : confidences) {
+      if (c.width() != w || c.height() != h) {
+        return fail(Errc::kSizeMismatch, "merge: confidence planes must have the output's size");
+      }
+    }
+  }
+  const std::size_t n = ranges.size();
   // The chosen members are gathered at the front of `chosen`; each new set is gathered behind
   // them in `next`, and copied in when the fold keeps it (alone or in a union).
   std::array<std::uint16_t, kMaxValues> chosen{};
   std::array<std::uint16_t, kWindow> next{};
+  std::array<std::uint16_t, kMaxRanges> centre{};
   for (int y = 0; y < h; ++y) {
     std::uint16_t* o = out.rowPtr(y);
+    std::uint8_t* oc = outConfidence != nullptr ? outConfidence->rowPtr(y) : nullptr;
     const int y0 = y > 0 ? y - 1 : 0;
     const int y1 = y + 1 < h ? y + 1 : h - 1;
     for (int x = 0; x < w; ++x) {
       o[x] = kNoDepth;
-      bool centre = false;
-      for (const ConstDepthPlane& r : ranges) {
-        centre = centre || r.rowPtr(y)[x] != kNoDepth;
+      if (oc != nullptr) {
+        oc[x] = 0;
       }
-      if (!centre) {
+      for (std::size_t i = 0; i < n; ++i) {
+        centre[i] = ranges[i].rowPtr(y)[x];
+      }
+      const std::uint16_t ref = reference(centre, n, tolerance);
+      if (ref == kNoDepth) {
         continue;
       }
+      // z within [ref − tol, ref + tol] and not kNoDepth, in one unsigned comparison.
+      const std::int32_t tol = tolerance.at(ref);
+      const std::int32_t low = ref > tol ? ref - tol : 1;
+      const auto span = static_cast<std::uint32_t>(ref + tol - low);
+      const auto agrees = [low, span](std::uint16_t z) {
+        return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
+      };
       const int x0 = x > 0 ? x - 1 : 0;
       const int x1 = x + 1 < w ? x + 1 : w - 1;
       Set best;
-      for (const ConstDepthPlane& r : ranges) {
+      std::int32_t error = 255;
+      int agreeing = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (centre[i] != kNoDepth && !agrees(centre[i])) {
+          continue;  // outvoted
+        }
+        if (oc != nullptr && centre[i] != kNoDepth) {
+          const std::int32_t e = 255 - confidences[i].rowPtr(y)[x];
+          error = e < error ? e : error;
+          ++agreeing;
+        }
+        const ConstDepthPlane& r = ranges[i];
         Set set;
         for (int yy = y0; yy <= y1; ++yy) {
           const std::uint16_t* row = r.rowPtr(yy);
           for (int xx = x0; xx <= x1; ++xx) {
             const std::uint16_t z = row[xx];
-            if (z != kNoDepth) {
+            if (agrees(z)) {
               next[static_cast<std::size_t>(set.count++)] = z;
               set.sum += z;
               set.sumSquares += std::int64_t{z} * z;
@@ -111,17 +198,35 @@ Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out
           continue;
         }
         const auto at = static_cast<std::size_t>(keep == 0 ? best.count : 0);
-        for (std::size_t i = 0; i < static_cast<std::size_t>(set.count); ++i) {
-          chosen[at + i] = next[i];
+        for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
+          chosen[at + k] = next[k];
         }
         best = keep == 0 ? Set{best.count + set.count, best.sum + set.sum,
                                best.sumSquares + set.sumSquares}
                          : set;
       }
       o[x] = median(chosen, static_cast<std::size_t>(best.count));
+      if (oc != nullptr) {
+        const std::int32_t e =
+            (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
+        oc[x] = static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+      }
     }
   }
   return {};
+}
+
+}  // namespace
+
+Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out,
+                         const DepthTolerance& tolerance) {
+  return merge(ranges, {}, out, nullptr, tolerance);
+}
+
+Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges,
+                         std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
+                         ImageView<std::uint8_t> outConfidence, const DepthTolerance& tolerance) {
+  return merge(ranges, confidences, out, &outConfidence, tolerance);
 }
 
 }  // namespace smx::algo

@@ -10,6 +10,7 @@
 
 #include "smx/algo/arena.hpp"
 #include "smx/algo/demux.hpp"
+#include "smx/algo/depth_trust.hpp"
 #include "smx/algo/error.hpp"
 #include "smx/algo/image_view.hpp"
 #include "smx/algo/range_image.hpp"
@@ -18,8 +19,9 @@
 #include "smx/algo/triangulation.hpp"
 
 // One camera's frame through the whole pipeline (docs/decode.md): orientation demultiplexing →
-// per projector multi-layer decoding → triangulation and the depth-edge filter → merging of the
-// projectors' range images (the paper's median-variant filter). Per frame integer-only and
+// per projector multi-layer decoding → triangulation, the trust filter and the depth-edge filter →
+// merging of the projectors' range images (consistency vote, then the paper's median-variant
+// filter), with a confidence per merged depth. Per frame integer-only and
 // allocation-free; all memory is carved from one arena at create().
 namespace smx::algo {
 
@@ -32,6 +34,9 @@ struct PipelineOptions {
   DemuxParams demux;
   DecodeParams decode;
   int edgeJumpPermille = 20;  // depth-edge filter of each pair's range image (0: off)
+  // Per pair: which depths to trust (depth_trust.hpp); its tolerance's minUnits is set from
+  // kGrossToleranceM and depthUnitM by prepareCameraPipeline.
+  DepthTrustParams trust;
 };
 
 // Init time (double, allocates): the tables the pipeline needs, computed from the rig.
@@ -39,6 +44,7 @@ struct CameraPipelineSetup {
   DemuxLayout layout;
   DecodeParams decode;
   int edgeJumpPermille = 20;
+  DepthTrustParams trust;
   double depthUnitM = kDefaultDepthUnitM;
   std::vector<std::uint16_t> predictedAngles;      // Demultiplexer::create's
   std::vector<TriangulationTables> triangulation;  // per projector
@@ -70,6 +76,10 @@ class CameraPipeline {
   [[nodiscard]] const DecodeStats& decodeStats(int projector) const;
   [[nodiscard]] ConstDepthPlane depth(int projector) const;  // that projector's range image
   [[nodiscard]] ConstDepthPlane merged() const;              // all projectors, merged
+  // Per-pixel confidence of depth(projector): 0 = no depth; 1…255 (depth_trust.hpp).
+  [[nodiscard]] ImageView<const std::uint8_t> confidence(int projector) const;
+  // Per-pixel confidence of merged(): 0 = no depth; 1…255 as documented in docs/decode.md.
+  [[nodiscard]] ImageView<const std::uint8_t> confidence() const;
 
  private:
   CameraPipeline() = default;
@@ -78,6 +88,7 @@ class CameraPipeline {
 
   DemuxLayout layout_;
   int edgeJumpPermille_ = 0;
+  DepthTrustParams trust_;
   std::optional<Demultiplexer> demux_;
   std::optional<StripeDecoder> decoder_;
   std::array<std::optional<Triangulator>, kMaxProjectors> triangulators_;
@@ -85,7 +96,9 @@ class CameraPipeline {
   std::array<ImageView<std::int16_t>, kMaxProjectors> levels_;
   std::array<DecodeStats, kMaxProjectors> stats_;
   std::array<DepthPlane, kMaxProjectors> depths_;
+  std::array<ImageView<std::uint8_t>, kMaxProjectors> confidences_;
   DepthPlane merged_;
+  ImageView<std::uint8_t> mergedConfidence_;
 };
 
 }  // namespace smx::algo

@@ -1,8 +1,11 @@
 #pragma once
 
+#include <cstdint>
 #include <span>
 
+#include "smx/algo/depth_trust.hpp"
 #include "smx/algo/error.hpp"
+#include "smx/algo/image_view.hpp"
 #include "smx/algo/range_image.hpp"
 
 // Merging one camera's range images, one per projector, into one (paper §4.3, "Occlusion";
@@ -13,6 +16,15 @@
 //   the set with more members; otherwise the one with the smaller variance, and when the
 //   variances are equal, both together. A one-member set has the largest variance; an empty set
 //   is never chosen. The output is the median of the chosen set.
+//
+// Consistency first (not in the paper: the filter would average a wrong range into a right one).
+// At each pixel the ranges with a value there vote: a value's support is the number of ranges
+// whose value lies within the gross tolerance tol(z) of it (itself included); the first value
+// with the most support is the reference when that support is a strict majority, otherwise the
+// pixel gets no depth (two ranges that disagree: no depth; three: the two that agree outvote the
+// third). A range whose value at the pixel disagrees with the reference takes no part; of the
+// others only window values within tol of the reference form the sets below, so nothing that
+// disagrees is ever blended in.
 //
 // Decisions where the paper is silent:
 //   - Three or more sets: a left fold in projector order, the running choice (a set or a union)
@@ -28,7 +40,18 @@ namespace smx::algo {
 
 inline constexpr int kMaxRanges = 8;
 
-// 1…kMaxRanges inputs, all the size of `out` (which may not alias them).
-[[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out);
+// 1…kMaxRanges inputs, all the size of `out` (which may not alias them). A tolerance of
+// {65535, 0} lets every value agree: the paper's filter alone.
+[[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out,
+                                       const DepthTolerance& tolerance = {});
+
+// The same, with each range's confidence (depth_trust.hpp) and the merged confidence: the
+// smallest predicted error u = 255 − c among the ranges that agree with the reference at the
+// pixel, divided by √k for k of them (independent measurements; 256/√k rounded, Q8), as
+// 255 − u; 0 where the merged plane has no depth.
+[[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges,
+                                       std::span<const ImageView<const std::uint8_t>> confidences,
+                                       DepthPlane out, ImageView<std::uint8_t> outConfidence,
+                                       const DepthTolerance& tolerance = {});
 
 }  // namespace smx::algo
