@@ -149,6 +149,12 @@ def range_frame(camera, compression, width, height, depth):
                        100000, 850) + depth
 
 
+def confidence_frame(camera, compression, width, height, depth, confidence):
+    """Message 9's payload: range-frame's fields, depth_bytes u32, the depth, the confidence."""
+    return (range_frame(camera, compression, width, height, b"") + struct.pack("<I", len(depth)) +
+            depth + confidence)
+
+
 def range_seeds():
     width, height = 5, 3
     values = [0 if k % 4 == 0 else 9000 + 37 * k for k in range(width * height)]
@@ -163,6 +169,14 @@ def range_seeds():
           announce + range_frame(0, 1, 65535, 65535, b""))
     write("range_frame", "near_camera_2_of_2.bin", announce + range_frame(2, 1, width, height,
                                                                           rvl(values)))
+    # Frames with the confidence plane (message 9): bit 7 of the announcement's first byte.
+    confidence = [0 if k % 4 == 0 else 200 + k for k in range(width * height)]
+    announce9 = struct.pack("<BHH", 0x81, width - 1, height - 1)
+    raw9 = confidence_frame(1, 0, width, height, raw, bytes(confidence))
+    rvl9 = confidence_frame(0, 1, width, height, rvl(values), rvl(confidence))
+    write("range_frame", "confidence_raw_5x3.bin", announce9 + raw9)
+    write("range_frame", "confidence_rvl_5x3.bin", announce9 + rvl9)
+    write("range_frame", "near_confidence_short_5x3.bin", announce9 + raw9[:-1])
 
     # The protocol target: a first byte with bit 7 set asks it to seal [type, length u16,
     # payload] records into messages with correct headers.
@@ -170,7 +184,8 @@ def range_seeds():
         return struct.pack("<BH", kind, len(payload)) + payload
     hello = struct.pack("<H", 14) + b"stripemux test"
     frames = (record(1, hello) + record(5, range_frame(0, 1, width, height, rvl(values))) +
-              record(6, b"") + record(5, range_frame(1, 0, width, height, raw)))
+              record(6, b"") + record(5, range_frame(1, 0, width, height, raw)) +
+              record(3, b"\x01\x01") + record(9, rvl9) + record(9, raw9))
     write("protocol", "sealed_hello_frames.bin", b"\x87" + frames)
     write("protocol", "sealed_frame_claims_65535.bin",
           b"\x90" + record(5, range_frame(0, 1, 65535, 65535, b"\x00")))

@@ -1,7 +1,7 @@
 // libFuzzer target for everything that reads bytes from the other side of the link: the stream
 // parser (framing, CRC, resynchronisation), every message decoder and RVL. Besides "no crash, no
 // sanitizer report" it checks that the parser always makes progress and that a range frame that
-// decodes re-encodes to the same depth.
+// decodes re-encodes to the same depth (and confidence).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -21,8 +21,8 @@ using namespace smx::protocol;
   std::abort();
 }
 
-void checkRangeFrame(std::span<const std::byte> payload) {
-  const auto frame = decodeRangeFrame(payload);
+void checkRangeFrame(const Message& message) {
+  const auto frame = decodeRangeFrame(message.payload, message.type);
   if (!frame) {
     return;
   }
@@ -31,20 +31,33 @@ void checkRangeFrame(std::span<const std::byte> payload) {
     return;
   }
   std::vector<std::uint16_t> depth(pixels);
-  if (!decodeRangeDepth(*frame, depth)) {
+  std::vector<std::uint8_t> confidence(frame->hasConfidence ? pixels : 0);
+  if (!decodeRangeDepth(*frame, depth) ||
+      (frame->hasConfidence && !decodeRangeConfidence(*frame, confidence))) {
     return;
   }
   // What decoded must survive a round trip exactly.
-  const auto plane =
-      *smx::algo::ConstDepthPlane::packed(depth, frame->header.width, frame->header.height);
-  std::vector<std::byte> buffer(rangeFrameBound(frame->header.width, frame->header.height));
-  const auto again = encodeRangeFrame(frame->header, plane, buffer);
+  const int width = frame->header.width;
+  const int height = frame->header.height;
+  const auto plane = *smx::algo::ConstDepthPlane::packed(depth, width, height);
+  std::vector<std::byte> buffer(rangeFrameBound(width, height, frame->hasConfidence));
+  const auto again = frame->hasConfidence
+                         ? encodeRangeFrame(frame->header, plane,
+                                            *smx::algo::ImageView<const std::uint8_t>::packed(
+                                                confidence, width, height),
+                                            buffer)
+                         : encodeRangeFrame(frame->header, plane, buffer);
   if (!again) {
     broken();
   }
-  const auto reframe = decodeRangeFrame(again->subspan(kHeaderBytes));
+  const auto reframe = decodeRangeFrame(again->subspan(kHeaderBytes), message.type);
   std::vector<std::uint16_t> back(pixels);
+  std::vector<std::uint8_t> confidenceBack(confidence.size());
   if (!reframe || !decodeRangeDepth(*reframe, back) || back != depth) {
+    broken();
+  }
+  if (frame->hasConfidence &&
+      (!decodeRangeConfidence(*reframe, confidenceBack) || confidenceBack != confidence)) {
     broken();
   }
 }
@@ -67,7 +80,8 @@ void decodeAny(const Message& message) {
       (void)decodeError(message.payload);
       break;
     case MessageType::kRangeFrame:
-      checkRangeFrame(message.payload);
+    case MessageType::kRangeFrameConfidence:
+      checkRangeFrame(message);
       break;
     default:
       (void)decodeEmpty(message.payload);
@@ -81,7 +95,7 @@ void decodeAny(const Message& message) {
 std::vector<std::byte> framed(std::span<const std::byte> records) {
   std::vector<std::byte> stream;
   while (records.size() >= 3) {
-    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 9U);
+    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 10U);
     const std::size_t length = std::min<std::size_t>(
         records.size() - 3,
         std::to_integer<std::size_t>(records[1]) | std::to_integer<std::size_t>(records[2]) << 8U);

@@ -109,10 +109,12 @@ class RawHost {
     ASSERT_TRUE(message.has_value());
     ASSERT_TRUE(socket_->sendAll(*message, 2000ms).has_value());
   }
-  void helloAndStart() {
+  void helloAndStart(bool confidence = false) {
     std::array<std::byte, 256> out{};
     send(protocol::encode(protocol::Hello{"raw host"}, out));
-    send(protocol::encode(protocol::StartStream{protocol::Compression::kRvl}, out));
+    send(protocol::encode(
+        protocol::StartStream{.compression = protocol::Compression::kRvl, .confidence = confidence},
+        out));
   }
   void startDraining() {
     reader_ = std::jthread([this] {
@@ -164,10 +166,11 @@ class FirmwareSim : public testing::Test {
   }
 };
 
-TEST_F(FirmwareSim, HundredFramesWhileStreamingAllocateNothing) {
+// 100 captures streamed to a host (with or without the confidence planes) allocate nothing.
+void expectHundredStreamedFramesAllocateNothing(bool confidence) {
   RunningDevice running(1);
   RawHost host(running.address());
-  host.helloAndStart();
+  host.helloAndStart(confidence);
   host.startDraining();
   // Warm up: the host is accepted and streaming, every buffer has been touched.
   while (!running.device->streaming()) {
@@ -195,14 +198,24 @@ TEST_F(FirmwareSim, HundredFramesWhileStreamingAllocateNothing) {
   EXPECT_GT(host.bytes(), 50U * 50'000U);
 }
 
-TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
+TEST_F(FirmwareSim, HundredFramesWhileStreamingAllocateNothing) {
+  expectHundredStreamedFramesAllocateNothing(false);
+}
+
+TEST_F(FirmwareSim, HundredFramesWithConfidenceWhileStreamingAllocateNothing) {
+  expectHundredStreamedFramesAllocateNothing(true);
+}
+
+// Streams 8 frames of two cameras (with the confidence planes when asked), checks that every
+// frame the device sent arrived, and compares each with `stripemux decode` of the same image.
+void expectStreamEqualsOfflineDecode(bool confidence) {
   RunningDevice running(2);
   running.startCapture();
   auto client = host::DeviceClient::connect(running.address(), 3000ms);
   ASSERT_TRUE(client.has_value()) << client.error();
   EXPECT_EQ(client->info().board, "sim");
   EXPECT_EQ(client->info().cameras, 2);
-  ASSERT_TRUE(client->startStream(protocol::Compression::kRvl).has_value());
+  ASSERT_TRUE(client->startStream(protocol::Compression::kRvl, confidence).has_value());
 
   std::vector<host::ReceivedFrame> frames;
   std::optional<protocol::Statistics> stats;
@@ -227,7 +240,9 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
   EXPECT_EQ(client->protocolErrors(), 0U);
 
   // `stripemux decode` on each replayed image, once.
-  const fs::path offline = fs::temp_directory_path() / "smx_firmware_sim_test_decode";
+  const fs::path offline =
+      fs::temp_directory_path() /
+      (confidence ? "smx_firmware_sim_test_decode_confidence" : "smx_firmware_sim_test_decode");
   for (int i = 0; i < kReplayFrames; ++i) {
     const std::string n = std::to_string(i);
     cli({"decode", "--rig", (kSource / "boards/sim/rig_2proj_2cam.json").string(), "--image",
@@ -240,12 +255,65 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
     // The simulated camera replays image k for its k-th frame; no capture failed here, so the
     // device's frame number is k.
     const std::string id = frame.header.camera == 0 ? "cam0" : "cam1";
-    const auto expected = sim::readPngGray16(
-        offline / std::to_string(frame.header.frame % kReplayFrames) / (id + ".depth.png"));
+    const fs::path decoded = offline / std::to_string(frame.header.frame % kReplayFrames);
+    const auto expected = sim::readPngGray16(decoded / (id + ".depth.png"));
     ASSERT_TRUE(expected.has_value());
     EXPECT_EQ(frame.depth, expected->pixels)
         << id << " frame " << frame.header.frame << " differs from stripemux decode";
+    if (!confidence) {
+      EXPECT_TRUE(frame.confidence.empty());
+      continue;
+    }
+    // 8-bit grey read as RGB: each channel is the confidence.
+    const auto expectedConfidence = sim::readPngRgb8(decoded / (id + ".confidence.png"));
+    ASSERT_TRUE(expectedConfidence.has_value());
+    ASSERT_EQ(frame.confidence.size(), expectedConfidence->pixels.size());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < frame.confidence.size(); ++i) {
+      differing += frame.confidence[i] != expectedConfidence->pixels[i].r ? 1 : 0;
+    }
+    EXPECT_EQ(differing, 0U) << id << " frame " << frame.header.frame
+                             << ": confidence differs from stripemux decode";
   }
+}
+
+TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
+  expectStreamEqualsOfflineDecode(false);
+}
+
+TEST_F(FirmwareSim, StreamedConfidenceEqualsOfflineDecodeAndEveryFrameSentArrives) {
+  expectStreamEqualsOfflineDecode(true);
+}
+
+// `stripemux stream --confidence` writes a confidence PNG beside each depth PNG, 0 exactly where
+// the depth is 0.
+TEST_F(FirmwareSim, StreamCommandWritesTheConfidenceBesideEachDepth) {
+  RunningDevice running(1);
+  running.startCapture();
+  const fs::path out = fs::temp_directory_path() / "smx_firmware_sim_test_stream_confidence";
+  fs::remove_all(out);
+  cli({"stream", "--device", running.address(), "--out", out.string(), "--frames", "2",
+       "--confidence", "--no-ply"});
+  int pairs = 0;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.ends_with(".depth.png")) {
+      continue;
+    }
+    const std::string stem = name.substr(0, name.size() - std::string(".depth.png").size());
+    const auto depth = sim::readPngGray16(entry.path());
+    const auto confidence = sim::readPngRgb8(out / (stem + ".confidence.png"));
+    ASSERT_TRUE(depth.has_value()) << depth.error();
+    ASSERT_TRUE(confidence.has_value()) << confidence.error();
+    ASSERT_EQ(confidence->pixels.size(), depth->pixels.size()) << stem;
+    std::size_t mismatched = 0;
+    for (std::size_t i = 0; i < depth->pixels.size(); ++i) {
+      mismatched += (confidence->pixels[i].r == 0) != (depth->pixels[i] == 0) ? 1 : 0;
+    }
+    EXPECT_EQ(mismatched, 0U) << stem;
+    ++pairs;
+  }
+  EXPECT_GE(pairs, 2);
 }
 
 TEST_F(FirmwareSim, AHostCanLeaveAndAnotherConnect) {

@@ -2,6 +2,7 @@
 // simulator's ground truth, and bad input rejected by name.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -34,6 +35,25 @@ class CliDecode : public test::CliTest {
     return out;
   }
 };
+
+// A PNG's size, bit depth and colour type, read from its IHDR chunk (bytes 16–25 of the file).
+struct PngKind {
+  int width = 0;
+  int height = 0;
+  int bitDepth = 0;
+  int colourType = -1;  // 0 grey
+};
+
+PngKind pngKind(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::array<unsigned char, 26> head{};
+  file.read(reinterpret_cast<char*>(head.data()), head.size());
+  const auto be32 = [&](std::size_t at) {
+    return static_cast<int>(head[at] << 24U | head[at + 1] << 16U | head[at + 2] << 8U |
+                            head[at + 3]);
+  };
+  return {be32(16), be32(20), head[24], head[25]};
+}
 
 // Share of the truth's surface pixels with depth, and of those the share within 3 mm.
 struct Agreement {
@@ -93,6 +113,26 @@ TEST_F(CliDecode, WritesDepthPointCloudsAndMetaThatMatchTheTruth) {
       EXPECT_GT(a.completeness, 0.8) << name;
       EXPECT_GT(a.within3mm, 0.97) << name;
     }
+    // The confidence plane beside the merged depth: 8-bit grey of the camera's size, 0 exactly
+    // where the depth is 0 (docs/cli.md).
+    const fs::path confidencePath = out / (cam + ".confidence.png");
+    const PngKind kind = pngKind(confidencePath);
+    EXPECT_EQ(kind.width, 640) << cam;
+    EXPECT_EQ(kind.height, 480) << cam;
+    EXPECT_EQ(kind.bitDepth, 8) << cam;
+    EXPECT_EQ(kind.colourType, 0) << cam;
+    const auto confidence = sim::readPngRgb8(confidencePath);
+    const auto depth = sim::readPngGray16(out / (cam + ".depth.png"));
+    ASSERT_TRUE(confidence && depth);
+    ASSERT_EQ(confidence->pixels.size(), depth->pixels.size());
+    int mismatched = 0;
+    for (std::size_t i = 0; i < depth->pixels.size(); ++i) {
+      mismatched += (confidence->pixels[i].r == 0) != (depth->pixels[i] == 0) ? 1 : 0;
+    }
+    EXPECT_EQ(mismatched, 0) << cam << ": confidence 0 where depth is not, or the reverse";
+    EXPECT_EQ(meta["cameras"][cam == "cam0" ? 0 : 1].at("confidence").get<std::string>(),
+              cam + ".confidence.png");
+
     const auto cloud = sim::readPlyPoints(out / (cam + ".ply"));
     ASSERT_TRUE(cloud) << cloud.error();
     EXPECT_GT(cloud->size(), 640U * 480U * 6U / 10U) << cam;

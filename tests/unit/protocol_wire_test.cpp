@@ -350,5 +350,197 @@ TEST(Protocol, EncodingAndParsingARangeFrameNeverAllocates) {
   EXPECT_EQ(back, depth);
 }
 
+// A confidence plane like a scan's: 0 exactly where `depth` is 0, 1…255 elsewhere, changing
+// slowly over surfaces and jumping at their edges.
+std::vector<std::uint8_t> confidenceOf(const std::vector<std::uint16_t>& depth) {
+  std::vector<std::uint8_t> confidence(depth.size());
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    confidence[i] = depth[i] == 0 ? 0 : static_cast<std::uint8_t>(1 + (depth[i] / 8) % 255);
+  }
+  return confidence;
+}
+
+TEST(StartStream, WithoutOptionsIsTheOneByteRequestOfEveryDevice) {
+  // Given a request without the confidence option, Then its payload is the compression only.
+  const Bytes plain = encoded(StartStream{.compression = Compression::kRvl});
+  ASSERT_EQ(plain.size(), kHeaderBytes + 1);
+  EXPECT_EQ(plain[kHeaderBytes], std::byte{1});
+  EXPECT_FALSE(decodeStartStream(std::span(plain).subspan(kHeaderBytes))->confidence);
+  // With it: a second byte, bit 0.
+  const Bytes asking = encoded(StartStream{.compression = Compression::kNone, .confidence = true});
+  ASSERT_EQ(asking.size(), kHeaderBytes + 2);
+  EXPECT_EQ(asking[kHeaderBytes + 1], std::byte{1});
+  const auto got = decodeStartStream(std::span(asking).subspan(kHeaderBytes));
+  ASSERT_TRUE(got.has_value());
+  EXPECT_TRUE(got->confidence);
+  EXPECT_EQ(got->compression, Compression::kNone);
+  // Unknown option bits and a third byte are refused.
+  EXPECT_FALSE(decodeStartStream(std::array{std::byte{1}, std::byte{2}}).has_value());
+  EXPECT_FALSE(decodeStartStream(std::array{std::byte{1}, std::byte{1}, std::byte{0}}).has_value());
+}
+
+TEST(RangeFrameConfidence, RoundTripsExactlyThroughTheParser) {
+  for (const Compression compression : {Compression::kRvl, Compression::kNone}) {
+    for (const auto& [width, height] : {std::pair{640, 480}, std::pair{1, 1}, std::pair{7, 3}}) {
+      const auto depth = sceneLikeDepth(width, height, 3);
+      const auto confidence = confidenceOf(depth);
+      const auto depthPlane = algo::ConstDepthPlane::packed(depth, width, height).value();
+      const auto confidencePlane =
+          algo::ImageView<const std::uint8_t>::packed(confidence, width, height).value();
+      Bytes buffer(rangeFrameBound(width, height, true));
+      const auto message = encodeRangeFrame(
+          {.camera = 1, .compression = compression, .frame = 7, .depthUnitNm = 50'000}, depthPlane,
+          confidencePlane, buffer);
+      ASSERT_TRUE(message.has_value());
+      StreamParser parser(kMaxPayloadBytes);
+      ASSERT_EQ(parser.feed(*message), message->size());
+      const auto parsed = parser.next();
+      ASSERT_TRUE(parsed.has_value() && parsed->has_value());
+      ASSERT_EQ((*parsed)->type, MessageType::kRangeFrameConfidence);
+      const auto frame = decodeRangeFrame((*parsed)->payload, MessageType::kRangeFrameConfidence);
+      ASSERT_TRUE(frame.has_value());
+      EXPECT_TRUE(frame->hasConfidence);
+      EXPECT_EQ(frame->header.frame, 7U);
+      EXPECT_EQ(frame->header.depthUnitNm, 50'000U);
+      std::vector<std::uint16_t> depthBack(depth.size());
+      std::vector<std::uint8_t> confidenceBack(depth.size());
+      ASSERT_TRUE(decodeRangeDepth(*frame, depthBack).has_value());
+      ASSERT_TRUE(decodeRangeConfidence(*frame, confidenceBack).has_value());
+      EXPECT_EQ(depthBack, depth);
+      EXPECT_EQ(confidenceBack, confidence);
+      if (width == 640) {
+        EXPECT_EQ(frame->header.compression, compression);
+      }
+      if (width == 640 && compression == Compression::kNone) {
+        EXPECT_EQ(message->size(), kHeaderBytes + 42 + 3 * depth.size());
+      }
+    }
+  }
+}
+
+TEST(RangeFrameConfidence, IncompressibleConfidenceSendsBothPlanesRaw) {
+  // Given smooth depth but a confidence that changes at every pixel by more than RVL saves.
+  const auto depth = sceneLikeDepth(64, 48, 9);
+  std::vector<std::uint8_t> confidence(depth.size());
+  std::mt19937 random(6);
+  for (auto& c : confidence) {
+    c = static_cast<std::uint8_t>(1 + random() % 255);
+  }
+  std::vector<std::uint16_t> full(depth.size(), 1000);  // no zeros: every confidence counts
+  const auto depthPlane = algo::ConstDepthPlane::packed(full, 64, 48).value();
+  const auto confidencePlane =
+      algo::ImageView<const std::uint8_t>::packed(confidence, 64, 48).value();
+  Bytes buffer(rangeFrameBound(64, 48, true));
+  const auto message =
+      encodeRangeFrame({.compression = Compression::kRvl}, depthPlane, confidencePlane, buffer);
+  ASSERT_TRUE(message.has_value());
+  const auto frame =
+      decodeRangeFrame(message->subspan(kHeaderBytes), MessageType::kRangeFrameConfidence);
+  ASSERT_TRUE(frame.has_value());
+  EXPECT_EQ(frame->header.compression, Compression::kNone);
+  std::vector<std::uint8_t> back(confidence.size());
+  ASSERT_TRUE(decodeRangeConfidence(*frame, back).has_value());
+  EXPECT_EQ(back, confidence);
+}
+
+TEST(RangeFrameConfidence, HostileSizesAreRefusedNamingThePlane) {
+  const auto depth = sceneLikeDepth(16, 8, 1);
+  const auto confidence = confidenceOf(depth);
+  const auto depthPlane = algo::ConstDepthPlane::packed(depth, 16, 8).value();
+  const auto confidencePlane =
+      algo::ImageView<const std::uint8_t>::packed(confidence, 16, 8).value();
+  const auto payloadOf = [&](Compression compression) {
+    Bytes buffer(rangeFrameBound(16, 8, true));
+    const auto message =
+        encodeRangeFrame({.compression = compression}, depthPlane, confidencePlane, buffer);
+    EXPECT_TRUE(message.has_value());
+    return Bytes(message->begin() + kHeaderBytes, message->end());
+  };
+  constexpr auto kType = MessageType::kRangeFrameConfidence;
+  constexpr std::size_t kDepthBytesAt = 38;  // after the header fields of message 5
+
+  // A raw confidence plane one byte short or long.
+  Bytes raw = payloadOf(Compression::kNone);
+  ASSERT_TRUE(decodeRangeFrame(raw, kType).has_value());
+  for (const bool longer : {false, true}) {
+    Bytes bad = raw;
+    longer ? bad.push_back(std::byte{9}) : bad.pop_back();
+    const auto frame = decodeRangeFrame(bad, kType);
+    ASSERT_FALSE(frame.has_value());
+    EXPECT_STREQ(frame.error().message,
+                 "range frame: raw confidence plane size does not match width x height");
+  }
+  // A depth size that runs past the payload.
+  Bytes past = raw;
+  past[kDepthBytesAt + 3] = std::byte{0x7F};
+  const auto pastFrame = decodeRangeFrame(past, kType);
+  ASSERT_FALSE(pastFrame.has_value());
+  EXPECT_STREQ(pastFrame.error().message,
+               "range frame: depth size runs past the end of the payload");
+
+  // Every cut of an RVL frame fails somewhere: the frame, its depth or its confidence.
+  const Bytes rvl = payloadOf(Compression::kRvl);
+  std::vector<std::uint16_t> depthBack(depth.size());
+  std::vector<std::uint8_t> confidenceBack(depth.size());
+  for (std::size_t cut = 0; cut < rvl.size(); ++cut) {
+    const auto frame = decodeRangeFrame(std::span(rvl).first(cut), kType);
+    const bool whole = frame && decodeRangeDepth(*frame, depthBack) &&
+                       decodeRangeConfidence(*frame, confidenceBack);
+    EXPECT_FALSE(whole) << "cut at " << cut;
+  }
+  // A depth-only frame has no confidence to read; a buffer of another size is refused.
+  Bytes depthOnlyBuffer(rangeFrameBound(16, 8));
+  const auto depthOnly =
+      encodeRangeFrame({.compression = Compression::kRvl}, depthPlane, depthOnlyBuffer);
+  ASSERT_TRUE(depthOnly.has_value());
+  const auto plain = decodeRangeFrame(depthOnly->subspan(kHeaderBytes));
+  ASSERT_TRUE(plain.has_value());
+  EXPECT_FALSE(plain->hasConfidence);
+  EXPECT_FALSE(decodeRangeConfidence(*plain, confidenceBack).has_value());
+  const auto full = decodeRangeFrame(rvl, kType);
+  ASSERT_TRUE(full.has_value());
+  std::vector<std::uint8_t> wrongSize(depth.size() + 1);
+  EXPECT_FALSE(decodeRangeConfidence(*full, wrongSize).has_value());
+  // Planes of different sizes are not encoded.
+  Bytes buffer(rangeFrameBound(16, 8, true));
+  const auto smaller =
+      algo::ImageView<const std::uint8_t>::packed(std::span(confidence).first(64), 8, 8).value();
+  EXPECT_FALSE(encodeRangeFrame({}, depthPlane, smaller, buffer).has_value());
+}
+
+TEST(Rvl, EightBitPlanesRefuseValuesAbove255) {
+  // Given one pixel whose coded value is 256 (zeros 0, values 1, zigzag 512 = 0o1000).
+  const std::array<std::byte, 3> in = {std::byte{0x01}, std::byte{0x88}, std::byte{0x81}};
+  std::array<std::uint16_t, 1> wide{};
+  ASSERT_TRUE(rvlDecode(std::span(in).first(3), wide).has_value());
+  EXPECT_EQ(wide[0], 256);
+  std::array<std::uint8_t, 1> narrow{};
+  EXPECT_FALSE(rvlDecode(in, narrow).has_value());
+}
+
+TEST(Protocol, EncodingAndParsingAConfidenceFrameNeverAllocates) {
+  const auto depth = sceneLikeDepth(640, 480, 2);
+  const auto confidence = confidenceOf(depth);
+  const auto depthPlane = algo::ConstDepthPlane::packed(depth, 640, 480).value();
+  const auto confidencePlane =
+      algo::ImageView<const std::uint8_t>::packed(confidence, 640, 480).value();
+  Bytes buffer(rangeFrameBound(640, 480, true));
+  std::vector<std::uint8_t> back(depth.size());
+  StreamParser parser(kMaxPayloadBytes);
+
+  const test::AllocationCounter counter;
+  const auto message =
+      encodeRangeFrame({.compression = Compression::kRvl}, depthPlane, confidencePlane, buffer);
+  ASSERT_TRUE(message.has_value());
+  ASSERT_EQ(parser.feed(*message), message->size());
+  const auto parsed = parser.next();
+  ASSERT_TRUE(parsed.has_value() && parsed->has_value());
+  const auto frame = decodeRangeFrame((*parsed)->payload, (*parsed)->type);
+  ASSERT_TRUE(frame.has_value());
+  ASSERT_TRUE(decodeRangeConfidence(*frame, back).has_value());
+  EXPECT_EQ(counter.allocations(), 0U);
+  EXPECT_EQ(back, confidence);
+}
+
 }  // namespace
 }  // namespace smx::protocol

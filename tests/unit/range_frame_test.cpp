@@ -104,5 +104,87 @@ TEST(RangeFrame, AnnouncedFrameDecodesAsSent) {
   EXPECT_EQ(frame->receivedNs, 123);
 }
 
+// The same with its confidence plane: depth and confidence of a 5x3 image, holes every fourth
+// pixel in both, as the device encodes them.
+struct ConfidenceFrame {
+  std::vector<std::uint16_t> depth;
+  std::vector<std::uint8_t> confidence;
+  std::vector<std::byte> payload;
+};
+
+ConfidenceFrame confidenceFrame(Compression compression) {
+  constexpr int kW = 5;
+  constexpr int kH = 3;
+  ConfidenceFrame f;
+  for (int i = 0; i < kW * kH; ++i) {
+    f.depth.push_back(static_cast<std::uint16_t>(i % 4 == 0 ? 0 : 9000 + i));
+    f.confidence.push_back(static_cast<std::uint8_t>(i % 4 == 0 ? 0 : 200 + i));
+  }
+  std::vector<std::byte> buffer(protocol::rangeFrameBound(kW, kH, true));
+  const auto message = protocol::encodeRangeFrame(
+      {.camera = 0, .compression = compression, .frame = 3},
+      *algo::ConstDepthPlane::packed(f.depth, kW, kH),
+      *algo::ImageView<const std::uint8_t>::packed(f.confidence, kW, kH), buffer);
+  EXPECT_TRUE(message.has_value());
+  f.payload.assign(message->begin() + protocol::kHeaderBytes, message->end());
+  return f;
+}
+
+constexpr AnnouncedFrames kTiny = {.cameras = 1, .width = 5, .height = 3};
+constexpr auto kWithConfidence = protocol::MessageType::kRangeFrameConfidence;
+
+TEST(RangeFrame, ConfidenceFrameDecodesAsSent) {
+  for (const Compression compression : {Compression::kRvl, Compression::kNone}) {
+    const ConfidenceFrame sent = confidenceFrame(compression);
+    const auto frame = receiveRangeFrame(sent.payload, kTiny, 0, kWithConfidence);
+    ASSERT_TRUE(frame.has_value()) << frame.error();
+    EXPECT_EQ(frame->depth, sent.depth);
+    EXPECT_EQ(frame->confidence, sent.confidence);
+  }
+  // A plain range frame carries no confidence.
+  std::vector<std::uint16_t> depth(15, 1000);
+  std::vector<std::byte> buffer(protocol::rangeFrameBound(5, 3));
+  const auto plain =
+      protocol::encodeRangeFrame({}, *algo::ConstDepthPlane::packed(depth, 5, 3), buffer);
+  ASSERT_TRUE(plain.has_value());
+  const auto frame = receiveRangeFrame(plain->subspan(protocol::kHeaderBytes), kTiny, 0);
+  ASSERT_TRUE(frame.has_value()) << frame.error();
+  EXPECT_TRUE(frame->confidence.empty());
+}
+
+// Given confidence planes one byte short, raw or RVL, when received, then the frame is refused
+// naming the confidence plane.
+TEST(RangeFrame, ConfidencePlaneOfTheWrongSizeIsRefusedNamingIt) {
+  for (const Compression compression : {Compression::kRvl, Compression::kNone}) {
+    ConfidenceFrame sent = confidenceFrame(compression);
+    sent.payload.pop_back();
+    const auto frame = receiveRangeFrame(sent.payload, kTiny, 0, kWithConfidence);
+    ASSERT_FALSE(frame.has_value());
+    EXPECT_NE(frame.error().find("confidence plane"), std::string::npos) << frame.error();
+  }
+}
+
+// Given a confidence frame claiming a depth of 4 GB and one claiming 65535x65535 pixels from a
+// device that announced that size, when received, then both are refused before anything near
+// the claims is allocated: the depth's size prefix is checked against the payload, and a frame
+// with confidence carries at most a third of the payload limit in pixels.
+TEST(RangeFrame, HostileConfidenceFrameSizesAreRefusedBeforeAllocating) {
+  std::vector<std::byte> hugeDepth = bareRangeFrame(0, 5, 3);
+  for (int i = 0; i < 4; ++i) {
+    hugeDepth.push_back(std::byte{0xFF});
+  }
+  std::vector<std::byte> huge = bareRangeFrame(0, 65535, 65535);
+  huge.resize(huge.size() + 4, std::byte{0});  // depth size 0, no confidence
+  const test::AllocationCounter counter;
+  const auto depthFrame = receiveRangeFrame(hugeDepth, kTiny, 0, kWithConfidence);
+  const auto hugeFrame =
+      receiveRangeFrame(huge, {.cameras = 1, .width = 65535, .height = 65535}, 0, kWithConfidence);
+  EXPECT_LT(counter.bytes(), 4096U);
+  ASSERT_FALSE(depthFrame.has_value());
+  EXPECT_NE(depthFrame.error().find("depth size"), std::string::npos) << depthFrame.error();
+  ASSERT_FALSE(hugeFrame.has_value());
+  EXPECT_NE(hugeFrame.error().find("1398101 pixels"), std::string::npos) << hugeFrame.error();
+}
+
 }  // namespace
 }  // namespace smx::host

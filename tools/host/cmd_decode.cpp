@@ -167,8 +167,13 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
                      {"boundary_pixels", stats.boundaryPixels},
                      {"decoded_boundary_pixels", stats.decodedPixels}});
   }
-  const std::string depthName = camera.id + ".depth.png";
+  const std::string depthName = depthPngName(camera.id);
   if (auto w = writeOrFail(writePngGray16(outputs.out, depthName, pipeline->merged())); !w) {
+    return std::unexpected(w.error());
+  }
+  const std::string confidenceName = confidencePngName(camera.id);
+  if (auto w = writeOrFail(writePngGray8(outputs.out, confidenceName, pipeline->confidence()));
+      !w) {
     return std::unexpected(w.error());
   }
   const auto points =
@@ -196,6 +201,7 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
                      {"width", camera.width},
                      {"height", camera.height},
                      {"depth", depthName},
+                     {"confidence", confidenceName},
                      {"ply", plyName},
                      {"valid_pixels", valid},
                      {"working_memory_bytes", *bytes},
@@ -267,7 +273,8 @@ void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
   cmd->add_option("--image", opts->images, "CAMERA=FILE: a camera's image (PNG), repeatable")
       ->required();
-  cmd->add_option("--out", opts->out, "Output directory: depth PNGs, PLY point clouds, meta.json")
+  cmd->add_option("--out", opts->out,
+                  "Output directory: depth and confidence PNGs, PLY point clouds, meta.json")
       ->required();
   cmd->add_option("--debug", opts->debug,
                   "Write per projector and camera: stripe segmentation, decoded stripes, depth");

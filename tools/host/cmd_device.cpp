@@ -41,6 +41,7 @@ struct StreamOptions {
   std::string compression = "rvl";
   double timeoutS = 30;
   bool noPly = false;
+  bool confidence = false;
 };
 
 bool isLoopback(const std::string& address) {
@@ -116,7 +117,7 @@ struct StreamTally {
     ++frames;
     ++perCamera[frame.header.camera];
     wireBytes += frame.wireBytes;
-    rawBytes += 2 * frame.depth.size();
+    rawBytes += 2 * frame.depth.size() + frame.confidence.size();
     decodeMsTotal += frame.header.decodeTimeUs / 1000.0;
     const std::int64_t captured = frame.header.captureTimestampNs;
     deviceMs.push_back(static_cast<double>(frame.header.sentTimestampNs - captured) / 1e6);
@@ -190,6 +191,7 @@ Json streamSummary(const StreamTally& tally, const DeviceInfo& info, const Strea
   summary["fps_per_camera"] = tally.fewestPerCamera(info.cameras) / elapsedS;
   summary["bytes_per_frame"] = tally.bytesPerFrame();
   summary["compression"] = opts.compression;
+  summary["confidence"] = opts.confidence;
   summary["compression_ratio"] = tally.ratio();
   summary["mbit_per_s_at_30fps_per_camera"] = tally.bytesPerFrame() * 8 * 30 / 1e6;
   summary["device_capture_to_queued_ms"] = meanAndP95(tally.deviceMs);
@@ -230,8 +232,8 @@ void printSummary(const StreamTally& tally, const DeviceInfo& info, const Stream
   }
   out << "\n";
   out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
-      << (opts.noPly ? "" : " and .ply") << ", " << merged
-      << ", <camera>.preview.png and summary.json\n";
+      << (opts.confidence ? ", .confidence.png" : "") << (opts.noPly ? "" : " and .ply") << ", "
+      << merged << ", <camera>.preview.png and summary.json\n";
 }
 
 // Each frame's files appear complete or not at all; a stream that fails keeps the frames it
@@ -250,8 +252,19 @@ class FrameWriter {
         *algo::ConstDepthPlane::packed(frame.depth, frame.header.width, frame.header.height);
     // camera.id passed the rig's id rules (parseRig), and the folder checks the name again.
     const std::string stem = camera.id + "_" + std::to_string(frame.header.frame);
-    if (auto ok = writePngGray16(out_, stem + ".depth.png", depth); !ok) {
+    if (auto ok = writePngGray16(out_, depthPngName(stem), depth); !ok) {
       return ok;
+    }
+    if (opts_.confidence) {
+      if (frame.confidence.empty()) {
+        return std::unexpected("the device sent frame " + std::to_string(frame.header.frame) +
+                               " of " + camera.id + " without the confidence asked for");
+      }
+      const auto confidence = *algo::ImageView<const std::uint8_t>::packed(
+          frame.confidence, frame.header.width, frame.header.height);
+      if (auto ok = writePngGray8(out_, confidencePngName(stem), confidence); !ok) {
+        return ok;
+      }
     }
     const double unitM = frame.header.depthUnitNm * 1e-9;
     auto points = depthToWorldPoints(camera, depth, unitM);
@@ -319,7 +332,7 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
     return kExitDeviceOrIo;
   }
   io.out << "connected to " << info.address << ": " << describe(info) << "\n";
-  if (auto started = client->startStream(compression); !started) {
+  if (auto started = client->startStream(compression, opts.confidence); !started) {
     io.err << "stripemux stream: " << printable(started.error()) << "\n";
     return kExitDeviceOrIo;
   }
@@ -427,6 +440,8 @@ void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--timeout", opts->timeoutS, "Give up after this many seconds (default 30)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-ply", opts->noPly, "Depth PNGs only, no point cloud per frame");
+  cmd->add_flag("--confidence", opts->confidence,
+                "Also a confidence PNG (8-bit) per frame, sent by the device beside the depth");
   cmd->callback([opts, &io, &exitCode] { exitCode = runStream(*opts, io); });
 }
 

@@ -140,8 +140,10 @@ std::expected<void, std::string> DeviceClient::send(
   return socket_.sendAll(*message, std::chrono::milliseconds(5000));
 }
 
-std::expected<void, std::string> DeviceClient::startStream(protocol::Compression compression) {
-  return send(protocol::encode(protocol::StartStream{compression}, out_));
+std::expected<void, std::string> DeviceClient::startStream(protocol::Compression compression,
+                                                           bool confidence) {
+  return send(protocol::encode(
+      protocol::StartStream{.compression = compression, .confidence = confidence}, out_));
 }
 
 std::expected<void, std::string> DeviceClient::stopStream() {
@@ -193,9 +195,10 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
   }
   const auto& [type, payload] = *got;
   switch (type) {
-    case MessageType::kRangeFrame: {
+    case MessageType::kRangeFrame:
+    case MessageType::kRangeFrameConfidence: {
       auto received = receiveRangeFrame(payload, {info_.cameras, info_.width, info_.height},
-                                        hal::SteadyClock().nowNs());
+                                        hal::SteadyClock().nowNs(), type);
       if (!received) {
         return Fail(received.error());
       }

@@ -48,7 +48,9 @@ class DeviceClient {
       const std::string& address, std::chrono::milliseconds timeout);
 
   [[nodiscard]] const DeviceInfo& info() const { return info_; }
-  [[nodiscard]] std::expected<void, std::string> startStream(protocol::Compression compression);
+  // `confidence`: each frame with its confidence plane (a device too old for it refuses).
+  [[nodiscard]] std::expected<void, std::string> startStream(protocol::Compression compression,
+                                                             bool confidence = false);
   [[nodiscard]] std::expected<void, std::string> stopStream();
   [[nodiscard]] std::expected<void, std::string> requestStatistics();
   [[nodiscard]] std::expected<DeviceEvent, std::string> next(std::chrono::milliseconds timeout);

@@ -15,6 +15,15 @@
 // The file kinds the commands write, each into an OutputFolder (names checked, complete or absent).
 namespace smx::host {
 
+// A camera's range image and its confidence plane, side by side (docs/cli.md); `stem` is the
+// camera's id, or id_frame in a stream.
+[[nodiscard]] inline std::string depthPngName(std::string_view stem) {
+  return std::string(stem) + ".depth.png";
+}
+[[nodiscard]] inline std::string confidencePngName(std::string_view stem) {
+  return std::string(stem) + ".confidence.png";
+}
+
 [[nodiscard]] inline std::expected<void, std::string> writePngRgb8(OutputFolder& folder,
                                                                    std::string_view name,
                                                                    algo::ConstRgbView image) {

@@ -4,9 +4,10 @@ namespace smx::host {
 
 std::expected<ReceivedFrame, std::string> receiveRangeFrame(std::span<const std::byte> payload,
                                                             const AnnouncedFrames& announced,
-                                                            std::int64_t receivedNs) {
+                                                            std::int64_t receivedNs,
+                                                            protocol::MessageType type) {
   using Fail = std::unexpected<std::string>;
-  const auto frame = protocol::decodeRangeFrame(payload);
+  const auto frame = protocol::decodeRangeFrame(payload, type);
   if (!frame) {
     return Fail(std::string("bad range frame: ") + frame.error().message);
   }
@@ -24,16 +25,24 @@ std::expected<ReceivedFrame, std::string> receiveRangeFrame(std::span<const std:
   // uncompressed; only RVL could carry a larger one, and RVL codes a field of zeros of any size
   // in a few bytes.
   const std::size_t pixels = std::size_t{header.width} * header.height;
-  if (2 * pixels > protocol::kMaxPayloadBytes) {
+  const std::size_t bytesPerPixel = frame->hasConfidence ? 3 : 2;
+  if (bytesPerPixel * pixels > protocol::kMaxPayloadBytes) {
     return Fail("bad range frame: " + std::to_string(header.width) + "x" +
                 std::to_string(header.height) + ", more than the " +
-                std::to_string(protocol::kMaxPayloadBytes / 2) + " pixels a range frame carries");
+                std::to_string(protocol::kMaxPayloadBytes / bytesPerPixel) +
+                " pixels a range frame carries");
   }
   ReceivedFrame received;
   received.header = header;
   received.depth.resize(pixels);
   if (const auto ok = protocol::decodeRangeDepth(*frame, received.depth); !ok) {
     return Fail(std::string("bad range frame: ") + ok.error().message);
+  }
+  if (frame->hasConfidence) {
+    received.confidence.resize(pixels);
+    if (const auto ok = protocol::decodeRangeConfidence(*frame, received.confidence); !ok) {
+      return Fail(std::string("bad range frame: confidence plane: ") + ok.error().message);
+    }
   }
   received.wireBytes = protocol::kHeaderBytes + payload.size();
   received.receivedNs = receivedNs;

@@ -68,8 +68,11 @@ void Device::queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uin
                                           .depthUnitNm = depthUnitNm_,
                                           .decodeTimeUs = decodeUs};
   const SendQueue::WriteSlot slot = queue_.beginWrite();
-  const auto message = protocol::encodeRangeFrame(
-      header, cameras_[static_cast<std::size_t>(camera)].pipeline->merged(), slot.bytes);
+  const algo::CameraPipeline& pipeline = *cameras_[static_cast<std::size_t>(camera)].pipeline;
+  const auto message =
+      confidence_
+          ? protocol::encodeRangeFrame(header, pipeline.merged(), pipeline.confidence(), slot.bytes)
+          : protocol::encodeRangeFrame(header, pipeline.merged(), slot.bytes);
   if (!message) {
     queue_.abandon(slot);
     ++counters_.captureErrors;

@@ -67,6 +67,7 @@ void Device::onMessage(const protocol::Message& message) {
         refuse(protocol::ErrorCode::kBadRequest, "start-stream before hello");
       } else {
         compression_ = start->compression;
+        confidence_ = start->confidence;
         streaming_ = true;
       }
       return;

@@ -18,10 +18,11 @@ Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& op
       allProjectorsMask_(static_cast<std::uint32_t>((1U << board.rig.projectors.size()) - 1U)),
       leadNs_(board.config.trigger.leadNs),
       startNs_(hal.clock.nowNs()),
-      // Each camera's decoder may hold a slot while writing, besides the queued frames.
+      // Each camera's decoder may hold a slot while writing, besides the queued frames. Every
+      // slot has room for the confidence plane: a host may ask for it at any start.
       queue_(options.queueSlots + board.rig.cameras.size() + 1,
              protocol::rangeFrameBound(board.rig.cameras.front().width,
-                                       board.rig.cameras.front().height)),
+                                       board.rig.cameras.front().height, true)),
       parser_(kControlBytes) {}
 
 Device::~Device() = default;

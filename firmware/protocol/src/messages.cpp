@@ -40,6 +40,104 @@ bool validCompression(std::uint8_t value) {
   return value <= 1;
 }
 
+// start-stream's optional second byte.
+constexpr std::uint8_t kOptionConfidence = 1U << 0U;
+
+void writeFrameHeader(ByteWriter& w, const RangeFrameHeader& header) {
+  w.put(header.camera);
+  w.put(static_cast<std::uint8_t>(header.compression));
+  w.put(header.width);
+  w.put(header.height);
+  w.put(header.frame);
+  w.put(static_cast<std::uint64_t>(header.captureTimestampNs));
+  w.put(static_cast<std::uint64_t>(header.sentTimestampNs));
+  w.put(header.depthUnitNm);
+  w.put(header.decodeTimeUs);
+}
+
+template <class Pixel>
+void writeRaw(ByteWriter& w, algo::ImageView<const Pixel> plane) {
+  for (int y = 0; y < plane.height(); ++y) {
+    for (const Pixel value : plane.row(y)) {
+      w.put(value);
+    }
+  }
+}
+
+// RVL into at most the raw size of `plane`; on overflow marks the writer failed (then the caller
+// sends the frame raw).
+template <class Pixel>
+void writeRvl(ByteWriter& w, algo::ImageView<const Pixel> plane) {
+  const std::size_t rawBytes = sizeof(Pixel) * static_cast<std::size_t>(plane.width()) *
+                               static_cast<std::size_t>(plane.height());
+  const std::span<std::byte> room = w.remaining();
+  const auto packed = rvlEncode(plane, room.first(std::min(room.size(), rawBytes)));
+  w.advance(packed ? *packed : room.size() + 1);
+}
+
+// The size prefix of the depth in a frame with confidence: written once the depth's bytes are
+// known, right before them.
+template <class Pixel>
+void writeRvlSized(ByteWriter& w, algo::ImageView<const Pixel> plane) {
+  const std::size_t rawBytes = sizeof(Pixel) * static_cast<std::size_t>(plane.width()) *
+                               static_cast<std::size_t>(plane.height());
+  const std::span<std::byte> room = w.remaining();
+  if (room.size() < sizeof(std::uint32_t)) {
+    w.advance(room.size() + 1);
+    return;
+  }
+  const std::span<std::byte> after = room.subspan(sizeof(std::uint32_t));
+  const auto packed = rvlEncode(plane, after.first(std::min(after.size(), rawBytes)));
+  if (!packed) {
+    w.advance(room.size() + 1);
+    return;
+  }
+  w.put(static_cast<std::uint32_t>(*packed));
+  w.advance(*packed);
+}
+
+ProtocolResult<std::span<const std::byte>> encodeFrame(
+    RangeFrameHeader header, algo::ConstDepthPlane depth,
+    const algo::ImageView<const std::uint8_t>* confidence, std::span<std::byte> out) {
+  header.width = static_cast<std::uint16_t>(depth.width());
+  header.height = static_cast<std::uint16_t>(depth.height());
+  if (depth.width() > 0xFFFF || depth.height() > 0xFFFF) {
+    return protocolFail(ProtocolErrc::kBufferTooSmall, "range image is larger than 65535 px");
+  }
+  if (confidence != nullptr &&
+      (confidence->width() != depth.width() || confidence->height() != depth.height())) {
+    return protocolFail(ProtocolErrc::kMalformed, "confidence plane is not the depth's size");
+  }
+  const MessageType type =
+      confidence != nullptr ? MessageType::kRangeFrameConfidence : MessageType::kRangeFrame;
+  if (header.compression == Compression::kRvl) {
+    auto rvl = build(type, out, [&](ByteWriter& w) {
+      writeFrameHeader(w, header);
+      if (confidence == nullptr) {
+        writeRvl(w, depth);
+        return;
+      }
+      writeRvlSized(w, depth);
+      writeRvl(w, *confidence);
+    });
+    if (rvl) {
+      return rvl;
+    }
+    header.compression = Compression::kNone;
+  }
+  return build(type, out, [&](ByteWriter& w) {
+    writeFrameHeader(w, header);
+    if (confidence != nullptr) {
+      w.put(static_cast<std::uint32_t>(2 * static_cast<std::size_t>(depth.width()) *
+                                       static_cast<std::size_t>(depth.height())));
+    }
+    writeRaw(w, depth);
+    if (confidence != nullptr) {
+      writeRaw(w, *confidence);
+    }
+  });
+}
+
 }  // namespace
 
 const char* toString(Compression compression) {
@@ -73,8 +171,12 @@ ProtocolResult<std::span<const std::byte>> encode(const Capabilities& m, std::sp
 }
 
 ProtocolResult<std::span<const std::byte>> encode(const StartStream& m, std::span<std::byte> out) {
-  return build(MessageType::kStartStream, out,
-               [&](ByteWriter& w) { w.put(static_cast<std::uint8_t>(m.compression)); });
+  return build(MessageType::kStartStream, out, [&](ByteWriter& w) {
+    w.put(static_cast<std::uint8_t>(m.compression));
+    if (m.confidence) {
+      w.put(kOptionConfidence);
+    }
+  });
 }
 
 ProtocolResult<std::span<const std::byte>> encode(const Statistics& m, std::span<std::byte> out) {
@@ -105,49 +207,13 @@ ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type, std::sp
 ProtocolResult<std::span<const std::byte>> encodeRangeFrame(RangeFrameHeader header,
                                                             algo::ConstDepthPlane depth,
                                                             std::span<std::byte> out) {
-  header.width = static_cast<std::uint16_t>(depth.width());
-  header.height = static_cast<std::uint16_t>(depth.height());
-  const auto writeHeader = [&](ByteWriter& w) {
-    w.put(header.camera);
-    w.put(static_cast<std::uint8_t>(header.compression));
-    w.put(header.width);
-    w.put(header.height);
-    w.put(header.frame);
-    w.put(static_cast<std::uint64_t>(header.captureTimestampNs));
-    w.put(static_cast<std::uint64_t>(header.sentTimestampNs));
-    w.put(header.depthUnitNm);
-    w.put(header.decodeTimeUs);
-  };
-  const auto writeRaw = [&](ByteWriter& w) {
-    writeHeader(w);
-    for (int y = 0; y < depth.height(); ++y) {
-      for (const std::uint16_t value : depth.row(y)) {
-        w.put(value);
-      }
-    }
-  };
-  if (depth.width() > 0xFFFF || depth.height() > 0xFFFF) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "range image is larger than 65535 px");
-  }
-  if (header.compression == Compression::kRvl) {
-    auto rvl = build(MessageType::kRangeFrame, out, [&](ByteWriter& w) {
-      writeHeader(w);
-      const std::size_t rawBytes =
-          2 * static_cast<std::size_t>(depth.width()) * static_cast<std::size_t>(depth.height());
-      const std::span<std::byte> room = w.remaining();
-      const auto packed = rvlEncode(depth, room.first(std::min(room.size(), rawBytes)));
-      if (packed) {
-        w.advance(*packed);
-      } else {
-        w.advance(room.size() + 1);  // marks the writer failed: fall back to raw below
-      }
-    });
-    if (rvl) {
-      return rvl;
-    }
-    header.compression = Compression::kNone;
-  }
-  return build(MessageType::kRangeFrame, out, writeRaw);
+  return encodeFrame(header, depth, nullptr, out);
+}
+
+ProtocolResult<std::span<const std::byte>> encodeRangeFrame(
+    RangeFrameHeader header, algo::ConstDepthPlane depth,
+    algo::ImageView<const std::uint8_t> confidence, std::span<std::byte> out) {
+  return encodeFrame(header, depth, &confidence, out);
 }
 
 ProtocolResult<Hello> decodeHello(std::span<const std::byte> payload) {
@@ -188,13 +254,19 @@ ProtocolResult<Capabilities> decodeCapabilities(std::span<const std::byte> paylo
 ProtocolResult<StartStream> decodeStartStream(std::span<const std::byte> payload) {
   ByteReader in(payload);
   const auto compression = in.get<std::uint8_t>();
+  // The options byte is optional: a host that asks for nothing sends the compression only.
+  const auto options = in.atEnd() ? std::uint8_t{0} : in.get<std::uint8_t>();
   if (auto ok = finished(in); !ok) {
     return std::unexpected(ok.error());
   }
   if (!validCompression(compression)) {
     return protocolFail(ProtocolErrc::kMalformed, "start-stream: unknown compression");
   }
-  return StartStream{static_cast<Compression>(compression)};
+  if ((options & ~kOptionConfidence) != 0) {
+    return protocolFail(ProtocolErrc::kMalformed, "start-stream: unknown options");
+  }
+  return StartStream{.compression = static_cast<Compression>(compression),
+                     .confidence = (options & kOptionConfidence) != 0};
 }
 
 ProtocolResult<Statistics> decodeStatistics(std::span<const std::byte> payload) {
@@ -233,7 +305,11 @@ ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload) {
   return {};
 }
 
-ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> payload) {
+ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> payload,
+                                                MessageType type) {
+  if (type != MessageType::kRangeFrame && type != MessageType::kRangeFrameConfidence) {
+    return protocolFail(ProtocolErrc::kMalformed, "not a range frame message");
+  }
   ByteReader in(payload);
   RangeFrameView m;
   m.header.camera = in.get<std::uint8_t>();
@@ -245,9 +321,20 @@ ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> paylo
   m.header.sentTimestampNs = static_cast<std::int64_t>(in.get<std::uint64_t>());
   m.header.depthUnitNm = in.get<std::uint32_t>();
   m.header.decodeTimeUs = in.get<std::uint32_t>();
-  m.depth = in.rest();
+  m.hasConfidence = type == MessageType::kRangeFrameConfidence;
+  const std::uint32_t depthBytes = m.hasConfidence ? in.get<std::uint32_t>() : 0;
   if (!in.ok()) {
     return protocolFail(ProtocolErrc::kMalformed, "range frame is shorter than its header");
+  }
+  if (m.hasConfidence) {
+    m.depth = in.getBytes(depthBytes);
+    if (!in.ok()) {
+      return protocolFail(ProtocolErrc::kMalformed,
+                          "range frame: depth size runs past the end of the payload");
+    }
+    m.confidence = in.rest();
+  } else {
+    m.depth = in.rest();
   }
   if (!validCompression(compression)) {
     return protocolFail(ProtocolErrc::kMalformed, "range frame: unknown compression");
@@ -260,6 +347,11 @@ ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> paylo
   if (m.header.compression == Compression::kNone && m.depth.size() != rawBytes) {
     return protocolFail(ProtocolErrc::kMalformed,
                         "range frame: raw depth size does not match width x height");
+  }
+  if (m.hasConfidence && m.header.compression == Compression::kNone &&
+      m.confidence.size() != rawBytes / 2) {
+    return protocolFail(ProtocolErrc::kMalformed,
+                        "range frame: raw confidence plane size does not match width x height");
   }
   return m;
 }
@@ -274,6 +366,24 @@ ProtocolResult<void> decodeRangeDepth(const RangeFrameView& frame, std::span<std
   ByteReader in(frame.depth);
   for (std::uint16_t& value : out) {
     value = in.get<std::uint16_t>();
+  }
+  return finished(in);
+}
+
+ProtocolResult<void> decodeRangeConfidence(const RangeFrameView& frame,
+                                           std::span<std::uint8_t> out) {
+  if (!frame.hasConfidence) {
+    return protocolFail(ProtocolErrc::kMalformed, "range frame has no confidence plane");
+  }
+  if (out.size() != std::size_t{frame.header.width} * frame.header.height) {
+    return protocolFail(ProtocolErrc::kBufferTooSmall, "confidence buffer is not width x height");
+  }
+  if (frame.header.compression == Compression::kRvl) {
+    return rvlDecode(frame.confidence, out);
+  }
+  ByteReader in(frame.confidence);
+  for (std::uint8_t& value : out) {
+    value = in.get<std::uint8_t>();
   }
   return finished(in);
 }

@@ -1,5 +1,7 @@
 #include "smx/protocol/rvl.hpp"
 
+#include <limits>
+
 namespace smx::protocol {
 
 namespace {
@@ -103,9 +105,9 @@ constexpr std::int32_t unzigzag(std::uint32_t code) {
   return static_cast<std::int32_t>(code >> 1) ^ -static_cast<std::int32_t>(code & 1U);
 }
 
-}  // namespace
-
-ProtocolResult<std::size_t> rvlEncode(algo::ConstDepthPlane depth, std::span<std::byte> out) {
+template <class Pixel>
+ProtocolResult<std::size_t> encodePlane(algo::ImageView<const Pixel> depth,
+                                        std::span<std::byte> out) {
   NibbleWriter writer(out);
   std::int32_t previous = 0;
   std::uint32_t zeros = 0;
@@ -153,7 +155,9 @@ ProtocolResult<std::size_t> rvlEncode(algo::ConstDepthPlane depth, std::span<std
   return static_cast<std::size_t>(bytes);
 }
 
-ProtocolResult<void> rvlDecode(std::span<const std::byte> in, std::span<std::uint16_t> out) {
+template <class Pixel>
+ProtocolResult<void> decodePlane(std::span<const std::byte> in, std::span<Pixel> out) {
+  constexpr std::int64_t kMaxValue = std::numeric_limits<Pixel>::max();
   NibbleReader reader(in);
   std::size_t filled = 0;
   std::int32_t previous = 0;
@@ -179,17 +183,38 @@ ProtocolResult<void> rvlDecode(std::span<const std::byte> in, std::span<std::uin
         return protocolFail(ProtocolErrc::kMalformed, "RVL data ends inside a run of values");
       }
       const std::int64_t value = std::int64_t{previous} + unzigzag(code);
-      if (value <= 0 || value > 0xFFFF) {
-        return protocolFail(ProtocolErrc::kMalformed, "RVL value outside 1..65535");
+      if (value <= 0 || value > kMaxValue) {
+        return protocolFail(ProtocolErrc::kMalformed, kMaxValue == 0xFF
+                                                          ? "RVL value outside 1..255"
+                                                          : "RVL value outside 1..65535");
       }
       previous = static_cast<std::int32_t>(value);
-      out[filled++] = static_cast<std::uint16_t>(value);
+      out[filled++] = static_cast<Pixel>(value);
     }
   }
   if (!reader.atEnd()) {
     return protocolFail(ProtocolErrc::kMalformed, "RVL data continues after the image");
   }
   return {};
+}
+
+}  // namespace
+
+ProtocolResult<std::size_t> rvlEncode(algo::ConstDepthPlane depth, std::span<std::byte> out) {
+  return encodePlane(depth, out);
+}
+
+ProtocolResult<std::size_t> rvlEncode(algo::ImageView<const std::uint8_t> plane,
+                                      std::span<std::byte> out) {
+  return encodePlane(plane, out);
+}
+
+ProtocolResult<void> rvlDecode(std::span<const std::byte> in, std::span<std::uint16_t> out) {
+  return decodePlane(in, out);
+}
+
+ProtocolResult<void> rvlDecode(std::span<const std::byte> in, std::span<std::uint8_t> out) {
+  return decodePlane(in, out);
 }
 
 }  // namespace smx::protocol

@@ -10,7 +10,7 @@ namespace smx::protocol {
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
   return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-         value <= static_cast<std::uint8_t>(MessageType::kError);
+         value <= static_cast<std::uint8_t>(MessageType::kRangeFrameConfidence);
 }
 
 const char* toString(MessageType type) {
@@ -31,6 +31,8 @@ const char* toString(MessageType type) {
       return "statistics";
     case MessageType::kError:
       return "error";
+    case MessageType::kRangeFrameConfidence:
+      return "range-frame-confidence";
   }
   return "unknown";
 }

@@ -108,6 +108,7 @@ class Device {
   SendQueue queue_;
   std::atomic<bool> streaming_ = false;
   std::atomic<protocol::Compression> compression_ = protocol::Compression::kRvl;
+  std::atomic<bool> confidence_ = false;  // the host asked for the confidence planes
 
   // Network thread only.
   protocol::StreamParser parser_;

@@ -36,6 +36,9 @@ struct Capabilities {
 
 struct StartStream {
   Compression compression = Compression::kRvl;
+  // Ask for the merged confidence plane with each range frame (message kRangeFrameConfidence).
+  // Off, the request is the one byte every device reads.
+  bool confidence = false;
 };
 
 struct RangeFrameHeader {
@@ -50,10 +53,13 @@ struct RangeFrameHeader {
   std::uint32_t decodeTimeUs = 0;  // the pipeline's time for this camera's frame
 };
 
-// A range frame as received: its header and the (possibly compressed) depth bytes.
+// A range frame as received: its header, the (possibly compressed) depth bytes and, in a
+// kRangeFrameConfidence message, the confidence bytes (compressed as the depth is).
 struct RangeFrameView {
   RangeFrameHeader header;
   std::span<const std::byte> depth;
+  bool hasConfidence = false;
+  std::span<const std::byte> confidence;
 };
 
 struct Statistics {
@@ -98,9 +104,16 @@ struct ErrorMessage {
 // compressed image would be larger than the raw one; the header says which was sent.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRangeFrame(
     RangeFrameHeader header, algo::ConstDepthPlane depth, std::span<std::byte> out);
-// Bytes a range frame of that size needs at most.
-[[nodiscard]] constexpr std::size_t rangeFrameBound(int width, int height) {
-  return kHeaderBytes + 40 + 2 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+// The same with the confidence plane of the depth (a kRangeFrameConfidence message); both planes
+// go RVL or both raw. kMalformed when the planes differ in size.
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRangeFrame(
+    RangeFrameHeader header, algo::ConstDepthPlane depth,
+    algo::ImageView<const std::uint8_t> confidence, std::span<std::byte> out);
+// Bytes a range frame of that size needs at most, with or without its confidence plane.
+[[nodiscard]] constexpr std::size_t rangeFrameBound(int width, int height,
+                                                    bool withConfidence = false) {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  return kHeaderBytes + 44 + (withConfidence ? 3 : 2) * pixels;
 }
 
 [[nodiscard]] ProtocolResult<Hello> decodeHello(std::span<const std::byte> payload);
@@ -109,9 +122,14 @@ struct ErrorMessage {
 [[nodiscard]] ProtocolResult<Statistics> decodeStatistics(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<ErrorMessage> decodeError(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload);
-[[nodiscard]] ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> payload);
+// The payload of a kRangeFrame or a kRangeFrameConfidence message (`type` says which).
+[[nodiscard]] ProtocolResult<RangeFrameView> decodeRangeFrame(
+    std::span<const std::byte> payload, MessageType type = MessageType::kRangeFrame);
 // Expands a range frame's depth bytes into `out` (width × height values, row by row).
 [[nodiscard]] ProtocolResult<void> decodeRangeDepth(const RangeFrameView& frame,
                                                     std::span<std::uint16_t> out);
+// Expands its confidence bytes into `out` (width × height values, row by row).
+[[nodiscard]] ProtocolResult<void> decodeRangeConfidence(const RangeFrameView& frame,
+                                                         std::span<std::uint8_t> out);
 
 }  // namespace smx::protocol

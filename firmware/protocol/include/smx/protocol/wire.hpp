@@ -36,6 +36,8 @@ enum class MessageType : std::uint8_t {
   kGetStatistics = 6,  // host → device
   kStatistics = 7,     // device → host: counters (answer to get-statistics, and at stream stop)
   kError = 8,          // device → host: a request was refused, with the reason
+  // device → host, only to a host that asked for it: a range frame with its confidence plane
+  kRangeFrameConfidence = 9,
 };
 
 [[nodiscard]] bool isKnown(MessageType type);
