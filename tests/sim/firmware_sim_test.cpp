@@ -270,7 +270,7 @@ void expectStreamEqualsOfflineDecode(bool confidence) {
     ASSERT_EQ(frame.confidence.size(), expectedConfidence->pixels.size());
     std::size_t differing = 0;
     for (std::size_t i = 0; i < frame.confidence.size(); ++i) {
-      differing += frame.confidence[i] != expectedConfidence->pixels[i].r ? 1 : 0;
+      differing += frame.confidence[i] != expectedConfidence->pixels[i].r ? 1U : 0U;
     }
     EXPECT_EQ(differing, 0U) << id << " frame " << frame.header.frame
                              << ": confidence differs from stripemux decode";
@@ -308,7 +308,7 @@ TEST_F(FirmwareSim, StreamCommandWritesTheConfidenceBesideEachDepth) {
     ASSERT_EQ(confidence->pixels.size(), depth->pixels.size()) << stem;
     std::size_t mismatched = 0;
     for (std::size_t i = 0; i < depth->pixels.size(); ++i) {
-      mismatched += (confidence->pixels[i].r == 0) != (depth->pixels[i] == 0) ? 1 : 0;
+      mismatched += (confidence->pixels[i].r == 0) != (depth->pixels[i] == 0) ? 1U : 0U;
     }
     EXPECT_EQ(mismatched, 0U) << stem;
     ++pairs;
