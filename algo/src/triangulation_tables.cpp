@@ -82,9 +82,9 @@ class RaySampler {
   Vec3 mr_;
 };
 
-// Coefficients of z = (A + B·s + E·s²) / (C + D·s), in that order: A, B, E, C, D.
-using Fit = std::array<double, 5>;
-constexpr std::size_t kFitNodes = 4;
+// Coefficients of z = (A + B·s + E·s² + F·s³) / (C + D·s), in that order: A, B, E, F, C, D.
+using Fit = std::array<double, 6>;
+constexpr std::size_t kFitNodes = 5;
 
 // The fit through kFitNodes points (s_k, z_k). Solved in t = s − s̄ (stripes, centred) with the
 // denominator 1 + D·t, which is 1 at s̄ (z is finite inside the range), then expanded in s.
@@ -95,11 +95,11 @@ std::optional<Fit> fitThrough(const std::array<double, kFitNodes>& s,
   for (const double v : s) {
     centre += v / kFitNodes;
   }
-  // Rows A + B·t + E·t² − D·t·z = z, Gaussian elimination with partial pivoting.
+  // Rows A + B·t + E·t² + F·t³ − D·t·z = z, Gauss–Jordan with partial pivoting.
   std::array<std::array<double, kFitNodes + 1>, kFitNodes> m{};
   for (std::size_t k = 0; k < kFitNodes; ++k) {
     const double t = s[k] - centre;
-    m[k] = {1.0, t, t * t, -t * z[k], z[k]};
+    m[k] = {1.0, t, t * t, t * t * t, -t * z[k], z[k]};
   }
   for (std::size_t c = 0; c < kFitNodes; ++c) {
     std::size_t pivot = c;
@@ -123,16 +123,22 @@ std::optional<Fit> fitThrough(const std::array<double, kFitNodes>& s,
   for (std::size_t k = 0; k < kFitNodes; ++k) {
     x[k] = m[k][kFitNodes] / m[k][k];
   }
-  const auto [a, b, e, d] = x;
-  return Fit{a - b * centre + e * centre * centre, b - 2.0 * e * centre, e, 1.0 - d * centre, d};
+  const auto [a, b, e, f, d] = x;
+  const double c = centre;
+  return Fit{a - b * c + e * c * c - f * c * c * c,
+             b - 2.0 * e * c + 3.0 * f * c * c,
+             e - 3.0 * f * c,
+             f,
+             1.0 - d * c,
+             d};
 }
 
 double denominatorOf(const Fit& f, double s) {
-  return f[3] + f[4] * s;
+  return f[4] + f[5] * s;
 }
 
 double depthOf(const Fit& f, double s) {
-  return (f[0] + s * (f[1] + s * f[2])) / denominatorOf(f, s);
+  return (f[0] + s * (f[1] + s * (f[2] + s * f[3]))) / denominatorOf(f, s);
 }
 
 }  // namespace
@@ -151,37 +157,36 @@ std::string formatted(const char* format, double value) {
   return text.data();
 }
 
-// The 2^k scaling of per-pixel A, B, E, C, D (each pixel's max(|C|, |D|) = 1): C', D' ≤ 2^30
-// and every numerator within 2^62 for any s in [0, 198) (triangulation.hpp).
+// Each fitted pixel's own 2^k scaling of A, B, E, F, C, D (num and den scale alike; max(|C|, |D|)
+// = 1): C', D' ≤ 2^30 and the numerator within 2^62 for any s in [0, 198) (triangulation.hpp).
 void scaleFitted(const std::vector<Fit>& fit, double depthUnitM, TriangulationTables& t) {
   const double sMax = 198.0;
-  double numeratorBound = 0.0;
-  for (const Fit& f : fit) {
-    numeratorBound = std::max(
-        numeratorBound,
-        (std::abs(f[0]) + std::abs(f[1]) * sMax + std::abs(f[2]) * sMax * sMax) * kStripeOne);
-  }
-  int k = 30;
-  while (std::ldexp(numeratorBound, k) / depthUnitM >= std::ldexp(1.0, 62)) {
-    --k;
-  }
   const std::size_t pixels = fit.size();
-  t.numeratorBases.resize(pixels);
-  t.numeratorSlopes.resize(pixels);
-  t.numeratorCurvatures.resize(pixels);
-  t.denominatorBase.resize(pixels);
-  t.denominatorSlope.resize(pixels);
+  t.numerators.resize(pixels);
+  t.denominatorBase.assign(pixels, 0);
+  t.denominatorSlope.assign(pixels, 0);
   for (std::size_t i = 0; i < pixels; ++i) {
-    t.numeratorBases[i] = std::llround(std::ldexp(fit[i][0], k) * kStripeOne / depthUnitM);
-    t.numeratorSlopes[i] = std::llround(std::ldexp(fit[i][1], k) / depthUnitM);
-    t.numeratorCurvatures[i] = std::llround(std::ldexp(fit[i][2], k) / depthUnitM);
-    t.denominatorBase[i] = static_cast<std::int32_t>(std::lround(std::ldexp(fit[i][3], k)));
-    t.denominatorSlope[i] = static_cast<std::int32_t>(std::lround(std::ldexp(fit[i][4], k)));
+    if (t.sense[i] == 0) {
+      continue;
+    }
+    const Fit& f = fit[i];
+    const double bound = (std::abs(f[0]) + std::abs(f[1]) * sMax + std::abs(f[2]) * sMax * sMax +
+                          std::abs(f[3]) * sMax * sMax * sMax) *
+                         kStripeOne / depthUnitM;
+    int k = 30;
+    while (std::ldexp(bound, k) >= std::ldexp(1.0, 62)) {
+      --k;
+    }
+    const auto scaled = [&](double v) { return std::ldexp(v, k) / depthUnitM; };
+    t.numerators[i] = {std::llround(scaled(f[0]) * kStripeOne), std::llround(scaled(f[1])),
+                       std::llround(scaled(f[2])), std::llround(scaled(f[3]))};
+    t.denominatorBase[i] = static_cast<std::int32_t>(std::lround(std::ldexp(f[4], k)));
+    t.denominatorSlope[i] = static_cast<std::int32_t>(std::lround(std::ldexp(f[5], k)));
   }
 }
 
-// A distorted projector: per pixel z = (A + B·s + E·s²) / (C + D·s) exact at kFitNodes depths
-// (Chebyshev nodes in 1/z over the working range), checked against exact s_d(z) at kSamples
+// A distorted projector: per pixel z = (A + B·s + E·s² + F·s³) / (C + D·s) exact at kFitNodes
+// depths (Chebyshev nodes in 1/z over the working range), checked against exact s_d(z) at kSamples
 // depths and at the nominal depth.
 std::expected<TriangulationTables, std::string> fittedTables(const Camera& cam,
                                                              const Projector& proj,
@@ -225,7 +230,7 @@ std::expected<TriangulationTables, std::string> fittedTables(const Camera& cam,
         nodeS[k] = seen ? seen->s : 0.0;
       }
       std::optional<Fit> f = defined ? fitThrough(nodeS, nodeZ) : std::nullopt;
-      const double scale = f ? std::max(std::abs((*f)[3]), std::abs((*f)[4])) : 0.0;
+      const double scale = f ? std::max(std::abs((*f)[4]), std::abs((*f)[5])) : 0.0;
       if (!(scale > 0.0) || !std::isfinite(scale)) {
         continue;
       }

@@ -9,11 +9,6 @@ namespace smx::algo {
 
 namespace {
 
-bool hasPerPixelNumerators(const TriangulationTables& tables) {
-  return !tables.numeratorBases.empty() || !tables.numeratorSlopes.empty() ||
-         !tables.numeratorCurvatures.empty();
-}
-
 Result<std::size_t> bytesFor(int width, int height, bool perPixelNumerators) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192) {
     return fail(Errc::kInvalidArgument, "triangulation: image size must be 1 to 8192 per side");
@@ -24,9 +19,7 @@ Result<std::size_t> bytesFor(int width, int height, bool perPixelNumerators) {
   (void)sizer.allocate<std::int32_t>(pixels);
   (void)sizer.allocate<std::int8_t>(pixels);
   if (perPixelNumerators) {
-    (void)sizer.allocate<std::int64_t>(pixels);
-    (void)sizer.allocate<std::int64_t>(pixels);
-    (void)sizer.allocate<std::int64_t>(pixels);
+    (void)sizer.allocate<PixelNumerator>(pixels);
   }
   return sizer.bytes();
 }
@@ -38,7 +31,7 @@ Result<std::size_t> Triangulator::workspaceBytes(int width, int height) {
 }
 
 Result<std::size_t> Triangulator::workspaceBytes(const TriangulationTables& tables) {
-  return bytesFor(tables.width, tables.height, hasPerPixelNumerators(tables));
+  return bytesFor(tables.width, tables.height, !tables.numerators.empty());
 }
 
 Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Arena& arena) {
@@ -47,12 +40,9 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   }
   const auto pixels =
       static_cast<std::size_t>(tables.width) * static_cast<std::size_t>(tables.height);
-  const bool perPixel = hasPerPixelNumerators(tables);
+  const bool perPixel = !tables.numerators.empty();
   if (tables.denominatorBase.size() != pixels || tables.denominatorSlope.size() != pixels ||
-      tables.sense.size() != pixels ||
-      (perPixel &&
-       (tables.numeratorBases.size() != pixels || tables.numeratorSlopes.size() != pixels ||
-        tables.numeratorCurvatures.size() != pixels))) {
+      tables.sense.size() != pixels || (perPixel && tables.numerators.size() != pixels)) {
     return fail(Errc::kSizeMismatch, "triangulation: tables must hold width x height entries");
   }
   Triangulator t;
@@ -65,9 +55,7 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   ok = ok ? carveSpan(arena, t.slope_, pixels) : ok;
   ok = ok ? carveSpan(arena, t.sense_, pixels) : ok;
   if (perPixel) {
-    ok = ok ? carveSpan(arena, t.numeratorBases_, pixels) : ok;
-    ok = ok ? carveSpan(arena, t.numeratorSlopes_, pixels) : ok;
-    ok = ok ? carveSpan(arena, t.numeratorCurvatures_, pixels) : ok;
+    ok = ok ? carveSpan(arena, t.numerators_, pixels) : ok;
   }
   if (!ok) {
     arena.rewind(start);
@@ -80,9 +68,7 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   }
   if (perPixel) {
     for (std::size_t i = 0; i < pixels; ++i) {
-      t.numeratorBases_[i] = tables.numeratorBases[i];
-      t.numeratorSlopes_[i] = tables.numeratorSlopes[i];
-      t.numeratorCurvatures_[i] = tables.numeratorCurvatures[i];
+      t.numerators_[i] = tables.numerators[i];
     }
   }
   return t;
@@ -106,7 +92,7 @@ Result<void> Triangulator::run(ConstStripePlane stripe, DepthPlane depth) const 
     return fail(Errc::kSizeMismatch,
                 "triangulation: stripe and depth planes must match the tables");
   }
-  if (numeratorBases_.empty()) {
+  if (numerators_.empty()) {
     runRows<false>(stripe, depth);
   } else {
     runRows<true>(stripe, depth);

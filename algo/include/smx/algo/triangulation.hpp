@@ -26,8 +26,9 @@
 //
 // With a distorted projector (k1 k2 p1 p2 k3, as the camera) z along one pixel's ray is no longer
 // a Möbius function of s (the distortion is cubic and more along the epipolar line), but over the
-// working depths it is close to z = (A + B·s + E·s²) / (C + D·s): each pixel gets its own
-// A, B, E, C, D, exact at four depths (Chebyshev nodes in 1/z over the working range), and the
+// working depths it is close to z = (A + B·s + E·s² + F·s³) / (C + D·s): each pixel gets its
+// own A, B, E, F, C, D, exact at five depths (Chebyshev nodes in 1/z over the working range), and
+// the
 // build measures the fit against exact s(z) and refuses a projector it cannot follow.
 namespace smx::algo {
 
@@ -45,20 +46,27 @@ inline constexpr double kMaxFitResidualM = 0.0001;
 // num = A' + B'·s, int64, A' and B' the constants A, B times 2^k·2^16 / depthUnitM (resp. 2^k /
 // depthUnitM), so that z in depth units is num / den; buildTriangulationTables lowers k until
 // |A'| + |B'|·198·2^16 < 2^62 for every pixel. The rounding of C', D' to integers is ≤ 2^-31
-// of their range. A distorted projector's numerator is per pixel, num = A' + B'·s + E'·⌊s²/2^16⌋
-// with E' = E·2^k / depthUnitM (each pixel's A, B, E, C, D scaled so that max(|C|, |D|) = 1 and
-// C + D·s > 0 over the working range; sense is then +1), k lowered until
-// |A'| + |B'|·198·2^16 + |E'|·198²·2^16 < 2^62.
+// of their range. A distorted projector's numerator is per pixel (PixelNumerator; each pixel's
+// A, B, E, F, C, D scaled so that max(|C|, |D|) = 1 and C + D·s > 0 over the working range;
+// sense is then +1), k lowered until |A'| + (|B'|·198 + |E'|·198² + |F'|·198³)·2^16 < 2^62.
+//
+// With s2 = ⌊s·s / 2^16⌋ and s3 = ⌊s2·s / 2^16⌋ (s ≥ 0; Q16 stripe² and stripe³, < 2^31.2 and
+// 2^38.9): num = A' + B'·s + E'·s2 + F'·s3, E' = E·2^k / depthUnitM, F' = F·2^k / depthUnitM.
+struct PixelNumerator {
+  std::int64_t base = 0;    // A'
+  std::int64_t slope = 0;   // B'
+  std::int64_t square = 0;  // E'
+  std::int64_t cube = 0;    // F'
+};
+
 struct TriangulationTables {
   int width = 0;
   int height = 0;
-  std::int64_t numeratorBase = 0;                 // A' (undistorted projector)
-  std::int64_t numeratorSlope = 0;                // B' (per Q16 unit of s)
-  std::vector<std::int64_t> numeratorBases;       // A' per pixel (distorted projector; else empty)
-  std::vector<std::int64_t> numeratorSlopes;      // B' per pixel
-  std::vector<std::int64_t> numeratorCurvatures;  // E' per pixel
-  std::vector<std::int32_t> denominatorBase;      // C' per pixel, row-major
-  std::vector<std::int32_t> denominatorSlope;     // D' per pixel
+  std::int64_t numeratorBase = 0;              // A' (undistorted projector)
+  std::int64_t numeratorSlope = 0;             // B' (per Q16 unit of s)
+  std::vector<PixelNumerator> numerators;      // per pixel (distorted projector; else empty)
+  std::vector<std::int32_t> denominatorBase;   // C' per pixel, row-major
+  std::vector<std::int32_t> denominatorSlope;  // D' per pixel
   // sign(B·C − A·D) per pixel (+1 for a fitted one); 0 where the pixel has no ray or, with a
   // distorted projector, s(z) along it is not defined and monotone over the working range.
   std::vector<std::int8_t> sense;
@@ -90,7 +98,7 @@ class Triangulator {
 
   // For tables of an undistorted projector (9 bytes per pixel).
   [[nodiscard]] static Result<std::size_t> workspaceBytes(int width, int height);
-  // For these tables (33 bytes per pixel with per-pixel numerators).
+  // For these tables (41 bytes per pixel with per-pixel numerators).
   [[nodiscard]] static Result<std::size_t> workspaceBytes(const TriangulationTables& tables);
   // Copies the tables into the arena.
   [[nodiscard]] static Result<Triangulator> create(const TriangulationTables& tables, Arena& arena);
@@ -102,7 +110,7 @@ class Triangulator {
   [[nodiscard]] std::uint16_t depthAt(int x, int y, StripeQ16 s) const {
     const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                           static_cast<std::size_t>(x);
-    return numeratorBases_.empty() ? depthOf<false>(i, s) : depthOf<true>(i, s);
+    return numerators_.empty() ? depthOf<false>(i, s) : depthOf<true>(i, s);
   }
 
   // depthAt for every pixel. Both planes must be width × height.
@@ -125,8 +133,10 @@ class Triangulator {
     std::int64_t den = (std::int64_t{base_[i]} << 16) + std::int64_t{slope_[i]} * s;
     std::int64_t num = 0;
     if constexpr (kPerPixel) {
-      const std::int64_t square = (std::int64_t{s} * s) >> 16;  // s ≥ 0 here: exact floor
-      num = numeratorBases_[i] + numeratorSlopes_[i] * s + numeratorCurvatures_[i] * square;
+      const PixelNumerator& n = numerators_[i];
+      const std::int64_t s2 = (std::int64_t{s} * s) >> 16;  // s ≥ 0 here: the floor
+      const std::int64_t s3 = (s2 * s) >> 16;
+      num = n.base + n.slope * s + n.square * s2 + n.cube * s3;
     } else {
       num = numeratorBase_ + numeratorSlope_ * s;
     }
@@ -151,9 +161,7 @@ class Triangulator {
   int height_ = 0;
   std::int64_t numeratorBase_ = 0;
   std::int64_t numeratorSlope_ = 0;
-  std::span<std::int64_t> numeratorBases_;
-  std::span<std::int64_t> numeratorSlopes_;
-  std::span<std::int64_t> numeratorCurvatures_;
+  std::span<PixelNumerator> numerators_;
   std::span<std::int32_t> base_;
   std::span<std::int32_t> slope_;
   std::span<std::int8_t> sense_;
