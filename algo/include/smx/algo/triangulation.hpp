@@ -27,9 +27,8 @@
 // With a distorted projector (k1 k2 p1 p2 k3, as the camera) z along one pixel's ray is no longer
 // a Möbius function of s (the distortion is cubic and more along the epipolar line), but over the
 // working depths it is close to z = (A + B·s + E·s² + F·s³) / (C + D·s): each pixel gets its
-// own A, B, E, F, C, D, exact at five depths (Chebyshev nodes in 1/z over the working range), and
-// the
-// build measures the fit against exact s(z) and refuses a projector it cannot follow.
+// own A, B, E, F, C, D, exact at five depths (Chebyshev nodes in 1/z over the working range),
+// and the build measures the fit against exact s(z) and refuses a projector it cannot follow.
 namespace smx::algo {
 
 // The working range a distorted projector's tables are fitted over: kFitNearFactor to
@@ -46,9 +45,10 @@ inline constexpr double kMaxFitResidualM = 0.0001;
 // num = A' + B'·s, int64, A' and B' the constants A, B times 2^k·2^16 / depthUnitM (resp. 2^k /
 // depthUnitM), so that z in depth units is num / den; buildTriangulationTables lowers k until
 // |A'| + |B'|·198·2^16 < 2^62 for every pixel. The rounding of C', D' to integers is ≤ 2^-31
-// of their range. A distorted projector's numerator is per pixel (PixelNumerator; each pixel's
-// A, B, E, F, C, D scaled so that max(|C|, |D|) = 1 and C + D·s > 0 over the working range;
-// sense is then +1), k lowered until |A'| + (|B'|·198 + |E'|·198² + |F'|·198³)·2^16 < 2^62.
+// of their range. A distorted projector's numerator is per pixel (PixelNumerator) and so is k:
+// each pixel's A, B, E, F, C, D are scaled so that max(|C|, |D|) = 1 and C + D·s > 0 over the
+// working range (sense is then +1), times 2^k with k = 30 lowered until
+// |A'| + (|B'|·198 + |E'|·198² + |F'|·198³)·2^16 < 2^62 (the num of any s in range fits int64).
 //
 // With s2 = ⌊s·s / 2^16⌋ and s3 = ⌊s2·s / 2^16⌋ (s ≥ 0; Q16 stripe² and stripe³, < 2^31.2 and
 // 2^38.9): num = A' + B'·s + E'·s2 + F'·s3, E' = E·2^k / depthUnitM, F' = F·2^k / depthUnitM.
