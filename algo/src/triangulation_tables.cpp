@@ -57,15 +57,15 @@ class RaySampler {
       : proj_(proj), g_(g), mr_(mr) {}
 
   struct Seen {
+    bool defined = false;  // in front of the projector
     double s = 0.0;
     bool lit = false;  // inside the projector image and the stripe sequence
   };
 
-  // nullopt behind the projector.
-  [[nodiscard]] std::optional<Seen> at(double z) const {
+  [[nodiscard]] Seen at(double z) const {
     const Vec3 xp{z * mr_[0] + g_.m[0], z * mr_[1] + g_.m[1], z * mr_[2] + g_.m[2]};
     if (!(xp[2] > 0.0)) {
-      return std::nullopt;
+      return {};
     }
     const lens::Point2 xd = lens::distort(proj_.dist, {xp[0] / xp[2], xp[1] / xp[2]});
     const double u = proj_.fx() * xd.x + proj_.cx();
@@ -73,7 +73,7 @@ class RaySampler {
     const double s = stripeCoordinate(proj_.pattern, proj_.width, proj_.height, u, v);
     const bool inImage =
         u >= -0.5 && v >= -0.5 && u <= proj_.width - 0.5 && v <= proj_.height - 0.5;
-    return Seen{s, inImage && s >= 0.0 && s < stripe::kStripes};
+    return {true, s, inImage && s >= 0.0 && s < stripe::kStripes};
   }
 
  private:
@@ -185,27 +185,98 @@ void scaleFitted(const std::vector<Fit>& fit, double depthUnitM, TriangulationTa
   }
 }
 
+// The working range's depths: the fit's Chebyshev nodes and the check's samples, even in 1/z.
+constexpr int kSamples = 17;
+struct RangeDepths {
+  std::array<double, kFitNodes> nodes{};
+  std::array<double, kSamples> samples{};
+  double nominal = 0.0;
+};
+
+RangeDepths rangeDepths(double nominalM) {
+  const double wNear = 1.0 / (kFitNearFactor * nominalM);
+  const double wFar = 1.0 / (kWorkingRangeFactor * nominalM);
+  RangeDepths r;
+  for (std::size_t k = 0; k < kFitNodes; ++k) {
+    const double cosine = std::cos((2.0 * static_cast<double>(k) + 1.0) * std::numbers::pi /
+                                   (2.0 * static_cast<double>(kFitNodes)));
+    r.nodes[k] = 1.0 / ((wNear + wFar) / 2.0 + cosine * (wNear - wFar) / 2.0);
+  }
+  for (std::size_t j = 0; j < r.samples.size(); ++j) {
+    r.samples[j] = 1.0 / (wNear - (wNear - wFar) * static_cast<double>(j) / (kSamples - 1));
+  }
+  r.nominal = nominalM;
+  return r;
+}
+
+struct PixelFit {
+  bool usable = false;
+  Fit fit{};
+  double rangeResidualM = 0.0;
+  double nominalMissM = 0.0;
+};
+
+// One pixel's fit, scaled so that max(|C|, |D|) = 1, and its check: every sample defined, s
+// strictly monotone in z, the denominator positive (as it is at the nodes' centre); the residual
+// over the lit samples and at the nominal depth.
+PixelFit fitPixel(const RaySampler& ray, const RangeDepths& depths) {
+  std::array<double, kFitNodes> nodeS{};
+  for (std::size_t k = 0; k < kFitNodes; ++k) {
+    const RaySampler::Seen seen = ray.at(depths.nodes[k]);
+    if (!seen.defined) {
+      return {};
+    }
+    nodeS[k] = seen.s;
+  }
+  const std::optional<Fit> solved = fitThrough(nodeS, depths.nodes);
+  if (!solved) {
+    return {};
+  }
+  PixelFit p;
+  p.fit = *solved;
+  const double scale = std::max(std::abs(p.fit[4]), std::abs(p.fit[5]));
+  if (!(scale > 0.0) || !std::isfinite(scale)) {
+    return {};
+  }
+  for (double& v : p.fit) {
+    v /= scale;
+  }
+  double previous = 0.0;
+  double direction = 0.0;
+  for (std::size_t j = 0; j < depths.samples.size(); ++j) {
+    const RaySampler::Seen seen = ray.at(depths.samples[j]);
+    if (!seen.defined || !(denominatorOf(p.fit, seen.s) > 0.0)) {
+      return {};
+    }
+    if (j > 0) {
+      const double step = seen.s - previous;
+      if (step == 0.0 || (direction != 0.0 && (step > 0.0) != (direction > 0.0))) {
+        return {};
+      }
+      direction = step;
+    }
+    previous = seen.s;
+    if (seen.lit) {
+      p.rangeResidualM =
+          std::max(p.rangeResidualM, std::abs(depthOf(p.fit, seen.s) - depths.samples[j]));
+    }
+  }
+  const RaySampler::Seen atNominal = ray.at(depths.nominal);
+  if (atNominal.defined && atNominal.lit) {
+    p.nominalMissM = std::abs(depthOf(p.fit, atNominal.s) - depths.nominal);
+  }
+  p.usable = true;
+  return p;
+}
+
 // A distorted projector: per pixel z = (A + B·s + E·s² + F·s³) / (C + D·s) exact at kFitNodes
-// depths (Chebyshev nodes in 1/z over the working range), checked against exact s_d(z) at kSamples
-// depths and at the nominal depth.
+// depths (Chebyshev nodes in 1/z over the working range), checked against exact s_d(z) at
+// kSamples depths and at the nominal depth.
 std::expected<TriangulationTables, std::string> fittedTables(const Camera& cam,
                                                              const Projector& proj,
                                                              const PairGeometry& g,
                                                              double depthUnitM, double nominalM) {
-  const double wNear = 1.0 / (kFitNearFactor * nominalM);
-  const double wFar = 1.0 / (kWorkingRangeFactor * nominalM);
-  std::array<double, kFitNodes> nodeZ{};
-  for (std::size_t k = 0; k < kFitNodes; ++k) {
-    const double cosine = std::cos((2.0 * static_cast<double>(k) + 1.0) * std::numbers::pi /
-                                   (2.0 * static_cast<double>(kFitNodes)));
-    nodeZ[k] = 1.0 / ((wNear + wFar) / 2.0 + cosine * (wNear - wFar) / 2.0);
-  }
-  constexpr int kSamples = 17;
-  std::array<double, kSamples> sampleZ{};
-  for (std::size_t j = 0; j < sampleZ.size(); ++j) {
-    sampleZ[j] = 1.0 / (wNear - (wNear - wFar) * static_cast<double>(j) / (kSamples - 1));
-  }
-
+  const RangeDepths depths = rangeDepths(nominalM);
   const auto pixels = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
   TriangulationTables t;
   t.width = cam.width;
@@ -216,63 +287,25 @@ std::expected<TriangulationTables, std::string> fittedTables(const Camera& cam,
   int worstY = 0;
   for (int y = 0; y < cam.height; ++y) {
     for (int x = 0; x < cam.width; ++x) {
-      const auto n =
-          lens::undistort(cam.dist, {(x - cam.cx()) / cam.fx(), (y - cam.cy()) / cam.fy()});
-      if (!n) {
+      const lens::Point2 n =
+          lens::undistort(cam.dist, {(x - cam.cx()) / cam.fx(), (y - cam.cy()) / cam.fy()})
+              .value_or(lens::Point2{std::nan(""), std::nan("")});
+      if (!std::isfinite(n.x)) {
         continue;
       }
-      const RaySampler ray(proj, g, mul(g.m3, {n->x, n->y, 1.0}));
-      std::array<double, kFitNodes> nodeS{};
-      bool defined = true;
-      for (std::size_t k = 0; k < kFitNodes; ++k) {
-        const auto seen = ray.at(nodeZ[k]);
-        defined = defined && seen.has_value();
-        nodeS[k] = seen ? seen->s : 0.0;
-      }
-      std::optional<Fit> f = defined ? fitThrough(nodeS, nodeZ) : std::nullopt;
-      const double scale = f ? std::max(std::abs((*f)[4]), std::abs((*f)[5])) : 0.0;
-      if (!(scale > 0.0) || !std::isfinite(scale)) {
-        continue;
-      }
-      for (double& v : *f) {
-        v /= scale;
-      }
-      // Every sample defined, s strictly monotone in z, the denominator positive (as it is at
-      // the nodes' centre); the residual over the lit samples.
-      double residual = 0.0;
-      double previous = 0.0;
-      double direction = 0.0;
-      bool usable = true;
-      for (std::size_t j = 0; j < sampleZ.size() && usable; ++j) {
-        const auto seen = ray.at(sampleZ[j]);
-        usable = seen && denominatorOf(*f, seen->s) > 0.0;
-        if (usable && j > 0) {
-          const double step = seen->s - previous;
-          usable = step != 0.0 && (direction == 0.0 || (step > 0.0) == (direction > 0.0));
-          direction = step;
-        }
-        if (usable) {
-          previous = seen->s;
-          if (seen->lit) {
-            residual = std::max(residual, std::abs(depthOf(*f, seen->s) - sampleZ[j]));
-          }
-        }
-      }
-      if (!usable) {
+      const PixelFit p = fitPixel(RaySampler(proj, g, mul(g.m3, {n.x, n.y, 1.0})), depths);
+      if (!p.usable) {
         continue;
       }
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(cam.width) +
                             static_cast<std::size_t>(x);
-      fit[i] = *f;
+      fit[i] = p.fit;
       t.sense[i] = 1;
-      t.rangeResidualM = std::max(t.rangeResidualM, residual);
-      if (const auto seen = ray.at(nominalM); seen && seen->lit) {
-        const double miss = std::abs(depthOf(*f, seen->s) - nominalM);
-        if (miss > t.nominalResidualM) {
-          t.nominalResidualM = miss;
-          worstX = x;
-          worstY = y;
-        }
+      t.rangeResidualM = std::max(t.rangeResidualM, p.rangeResidualM);
+      if (p.nominalMissM > t.nominalResidualM) {
+        t.nominalResidualM = p.nominalMissM;
+        worstX = x;
+        worstY = y;
       }
     }
   }
