@@ -25,7 +25,8 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
   }
   setup.predictedAngles = std::move(*angles);
   for (int p = 0; p < setup.layout.projectors; ++p) {
-    auto tables = buildTriangulationTables(rig, camera, p, options.depthUnitM);
+    auto tables =
+        buildTriangulationTables(rig, camera, p, options.depthUnitM, options.nominalDepthM);
     if (!tables) {
       return std::unexpected(tables.error());
     }

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -259,13 +260,153 @@ TEST(TriangulationTables, IntersectionsBehindTheProjectorHaveNoDepth) {
   EXPECT_GT(returned, 1000);
 }
 
-TEST(TriangulationTables, ProjectorDistortionIsRejectedNamingTheProjector) {
+// Where a point lands in the projector image: its stripe is lit only inside it.
+bool insideProjector(const Rig& rig, int x, int y, double zM) {
+  const Camera& cam = rig.cameras[0];
+  const Projector& proj = rig.projectors[0];
+  const auto local = lens::devicePoint(cam, {static_cast<double>(x), static_cast<double>(y)}, zM);
+  const auto uv = lens::project(proj, lens::toWorld(cam, *local));
+  return uv && uv->x >= -0.5 && uv->y >= -0.5 && uv->x <= proj.width - 0.5 &&
+         uv->y <= proj.height - 0.5;
+}
+
+Result<Triangulator> triangulatorFor(const TriangulationTables& tables,
+                                     std::vector<std::byte>& memory) {
+  memory.resize(*Triangulator::workspaceBytes(tables));
+  Arena arena(memory);
+  return Triangulator::create(tables, arena);
+}
+
+constexpr double kNominalM = 0.9;
+
+// Given a projector with a realistic lens (barrel, a little tangential), when exact stripe
+// coordinates of points on pixel rays (lens::project, the simulator's own model) are
+// triangulated, then every depth within the working range (0.45–1.8 m) is within 0.1 mm of the
+// true one, and every point inside the projector image gets a depth.
+TEST(DistortedProjector, ExactStripeGivesTheDepthWithinATenthOfAMillimetre) {
   Rig rig = makeRig();
-  rig.projectors[0].dist = {0.01, 0, 0, 0, 0};
-  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM);
+  rig.projectors[0].dist = {-0.05, 0.01, 0.001, -0.0005, 0.0};
+  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
+  ASSERT_TRUE(tables) << tables.error();
+  EXPECT_FALSE(tables->numerators.empty());
+  std::vector<std::byte> memory;
+  const auto t = triangulatorFor(*tables, memory);
+  ASSERT_TRUE(t);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> px(0, 319);
+  std::uniform_int_distribution<int> py(0, 239);
+  std::uniform_real_distribution<double> inverseDepth(1.0 / 1.8, 1.0 / 0.45);
+  int checked = 0;
+  double worst = 0;
+  for (int i = 0; i < 40000; ++i) {
+    const Sample s = sampleAt(rig, px(rng), py(rng), 1.0 / inverseDepth(rng));
+    if (!s.stripe || *s.stripe < 0 || *s.stripe >= 198 || !insideProjector(rig, s.x, s.y, s.zM)) {
+      continue;
+    }
+    const std::uint16_t z = t->depthAt(s.x, s.y, q16(*s.stripe));
+    ASSERT_NE(z, kNoDepth) << s.x << "," << s.y << " z " << s.zM;
+    const double errorM = std::abs(z * kDefaultDepthUnitM - s.zM);
+    worst = std::max(worst, errorM);
+    ASSERT_LE(errorM, 0.0001) << s.x << "," << s.y << " z " << s.zM;
+    ++checked;
+  }
+  EXPECT_GT(checked, 15000);
+  std::printf(
+      "distorted projector: %d points, worst %.4f mm (fit: %.4f mm at %.2f m, %.4f mm "
+      "over the range)\n",
+      checked, worst * 1000, tables->nominalResidualM * 1000, kNominalM,
+      tables->rangeResidualM * 1000);
+}
+
+// The same tables through run(): the per-pixel numerators, still without the heap.
+TEST(DistortedProjector, RunMatchesDepthAtWithoutTouchingTheHeap) {
+  Rig rig = makeRig();
+  rig.projectors[0].dist = {0.04, 0.0, 0.0, 0.0, 0.0};
+  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
+  ASSERT_TRUE(tables) << tables.error();
+  std::vector<std::byte> memory;
+  const auto t = triangulatorFor(*tables, memory);
+  ASSERT_TRUE(t);
+  const int w = rig.cameras[0].width;
+  const int h = rig.cameras[0].height;
+  std::vector<StripeQ16> stripe(static_cast<std::size_t>(w * h), kNoStripe);
+  std::vector<double> truth(stripe.size(), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const Sample s = sampleAt(rig, x, y, 0.7 + 0.002 * x);
+      if (s.stripe && *s.stripe >= 0 && *s.stripe < 198 && insideProjector(rig, x, y, s.zM)) {
+        stripe[static_cast<std::size_t>(y * w + x)] = q16(*s.stripe);
+        truth[static_cast<std::size_t>(y * w + x)] = s.zM / kDefaultDepthUnitM;
+      }
+    }
+  }
+  std::vector<std::uint16_t> depth(stripe.size(), 1234);
+  const test::AllocationCounter counter;
+  ASSERT_TRUE(t->run(*ConstStripePlane::packed(stripe, w, h), *DepthPlane::packed(depth, w, h)));
+  EXPECT_EQ(counter.allocations(), 0U);
+  int filled = 0;
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    if (stripe[i] == kNoStripe) {
+      EXPECT_EQ(depth[i], kNoDepth);
+    } else {
+      EXPECT_NEAR(depth[i], truth[i], 1.0) << i;
+      ++filled;
+    }
+  }
+  EXPECT_GT(filled, w * h / 3);
+}
+
+// An undistorted projector keeps the closed form (the tests above): one shared numerator, and
+// a nominal depth changes nothing.
+TEST(DistortedProjector, UndistortedTablesDoNotDependOnTheWorkingRange) {
+  const Rig rig = makeRig();
+  const auto plain = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM);
+  const auto ranged = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, 0.3);
+  ASSERT_TRUE(plain && ranged);
+  EXPECT_TRUE(ranged->numerators.empty());
+  EXPECT_EQ(ranged->numeratorBase, plain->numeratorBase);
+  EXPECT_EQ(ranged->numeratorSlope, plain->numeratorSlope);
+  EXPECT_EQ(ranged->denominatorBase, plain->denominatorBase);
+  EXPECT_EQ(ranged->denominatorSlope, plain->denominatorSlope);
+  EXPECT_EQ(ranged->sense, plain->sense);
+  EXPECT_EQ(*Triangulator::workspaceBytes(*plain), *Triangulator::workspaceBytes(320, 240));
+}
+
+// The per-pixel numerators need their own arena space: the undistorted size is refused.
+TEST(DistortedProjector, TablesNeedTheirOwnWorkspace) {
+  Rig rig = makeRig();
+  rig.projectors[0].dist = {0.02, 0.0, 0.0, 0.0, 0.0};
+  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
+  ASSERT_TRUE(tables) << tables.error();
+  const std::size_t plain = *Triangulator::workspaceBytes(320, 240);
+  EXPECT_GE(*Triangulator::workspaceBytes(*tables), plain + 32U * 320U * 240U);
+  std::vector<std::byte> memory(plain);
+  Arena arena(memory);
+  EXPECT_FALSE(Triangulator::create(*tables, arena));
+  TriangulationTables torn = *tables;
+  torn.numerators.pop_back();
+  std::vector<std::byte> enough;
+  const auto t = triangulatorFor(torn, enough);
+  ASSERT_FALSE(t);
+  EXPECT_EQ(t.error().code, Errc::kSizeMismatch);
+}
+
+// A lens the fit cannot follow to 0.1 mm at the nominal depth is refused, by its measured
+// residual, naming the projector; a distorted projector needs a working range.
+TEST(DistortedProjector, TooStrongDistortionIsRefusedNamingTheProjector) {
+  Rig rig = makeRig();
+  rig.projectors[0].dist = {-0.4, 0.0, 0.0, 0.0, 0.0};
+  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
   ASSERT_FALSE(tables);
   EXPECT_NE(tables.error().find("proj0"), std::string::npos) << tables.error();
-  EXPECT_NE(tables.error().find("distortion"), std::string::npos) << tables.error();
+  EXPECT_NE(tables.error().find("0.1 mm"), std::string::npos) << tables.error();
+  EXPECT_NE(tables.error().find("nominal depth 0.9 m"), std::string::npos) << tables.error();
+
+  const auto unranged = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM);
+  ASSERT_FALSE(unranged);
+  EXPECT_NE(unranged.error().find("proj0"), std::string::npos) << unranged.error();
+  EXPECT_FALSE(buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, 0.0));
+  EXPECT_FALSE(buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, -1.0));
 }
 
 TEST(TriangulationTables, BadIndicesAndUnitsAreRejected) {

@@ -7,7 +7,9 @@
 
 namespace smx::algo {
 
-Result<std::size_t> Triangulator::workspaceBytes(int width, int height) {
+namespace {
+
+Result<std::size_t> bytesFor(int width, int height, bool perPixelNumerators) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192) {
     return fail(Errc::kInvalidArgument, "triangulation: image size must be 1 to 8192 per side");
   }
@@ -16,7 +18,20 @@ Result<std::size_t> Triangulator::workspaceBytes(int width, int height) {
   (void)sizer.allocate<std::int32_t>(pixels);
   (void)sizer.allocate<std::int32_t>(pixels);
   (void)sizer.allocate<std::int8_t>(pixels);
+  if (perPixelNumerators) {
+    (void)sizer.allocate<PixelNumerator>(pixels);
+  }
   return sizer.bytes();
+}
+
+}  // namespace
+
+Result<std::size_t> Triangulator::workspaceBytes(int width, int height) {
+  return bytesFor(width, height, false);
+}
+
+Result<std::size_t> Triangulator::workspaceBytes(const TriangulationTables& tables) {
+  return bytesFor(tables.width, tables.height, !tables.numerators.empty());
 }
 
 Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Arena& arena) {
@@ -25,8 +40,9 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   }
   const auto pixels =
       static_cast<std::size_t>(tables.width) * static_cast<std::size_t>(tables.height);
+  const bool perPixel = !tables.numerators.empty();
   if (tables.denominatorBase.size() != pixels || tables.denominatorSlope.size() != pixels ||
-      tables.sense.size() != pixels) {
+      tables.sense.size() != pixels || (perPixel && tables.numerators.size() != pixels)) {
     return fail(Errc::kSizeMismatch, "triangulation: tables must hold width x height entries");
   }
   Triangulator t;
@@ -38,6 +54,9 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
   Result<void> ok = carveSpan(arena, t.base_, pixels);
   ok = ok ? carveSpan(arena, t.slope_, pixels) : ok;
   ok = ok ? carveSpan(arena, t.sense_, pixels) : ok;
+  if (perPixel) {
+    ok = ok ? carveSpan(arena, t.numerators_, pixels) : ok;
+  }
   if (!ok) {
     arena.rewind(start);
     return std::unexpected(ok.error());
@@ -47,7 +66,24 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
     t.slope_[i] = tables.denominatorSlope[i];
     t.sense_[i] = tables.sense[i];
   }
+  if (perPixel) {
+    for (std::size_t i = 0; i < pixels; ++i) {
+      t.numerators_[i] = tables.numerators[i];
+    }
+  }
   return t;
+}
+
+template <bool kPerPixel>
+void Triangulator::runRows(ConstStripePlane stripe, DepthPlane depth) const {
+  for (int y = 0; y < height_; ++y) {
+    const StripeQ16* s = stripe.rowPtr(y);
+    std::uint16_t* z = depth.rowPtr(y);
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
+    for (int x = 0; x < width_; ++x) {
+      z[x] = depthOf<kPerPixel>(row + static_cast<std::size_t>(x), s[x]);
+    }
+  }
 }
 
 Result<void> Triangulator::run(ConstStripePlane stripe, DepthPlane depth) const {
@@ -56,12 +92,10 @@ Result<void> Triangulator::run(ConstStripePlane stripe, DepthPlane depth) const 
     return fail(Errc::kSizeMismatch,
                 "triangulation: stripe and depth planes must match the tables");
   }
-  for (int y = 0; y < height_; ++y) {
-    const StripeQ16* s = stripe.rowPtr(y);
-    std::uint16_t* z = depth.rowPtr(y);
-    for (int x = 0; x < width_; ++x) {
-      z[x] = depthAt(x, y, s[x]);
-    }
+  if (numerators_.empty()) {
+    runRows<false>(stripe, depth);
+  } else {
+    runRows<true>(stripe, depth);
   }
   return {};
 }
