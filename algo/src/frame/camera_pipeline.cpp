@@ -67,8 +67,10 @@ Result<std::size_t> CameraPipeline::workspaceBytes(const CameraPipelineSetup& se
   };
   Result<void> ok = add(Demultiplexer::workspaceBytes(l));
   ok = ok ? add(StripeDecoder::workspaceBytes(l.width, l.height, setup.decode)) : ok;
+  // validate() checked one table per projector; a distorted projector's tables hold per-pixel
+  // numerators, so each is sized by its own tables.
   for (int p = 0; ok && p < l.projectors; ++p) {
-    ok = add(Triangulator::workspaceBytes(l.width, l.height));
+    ok = add(Triangulator::workspaceBytes(setup.triangulation[static_cast<std::size_t>(p)]));
   }
   CameraPipeline sized;
   sized.layout_ = l;
