@@ -38,6 +38,9 @@ inline constexpr double kFitNearFactor = 0.5;
 // The largest fit residual (|depth of the fit − exact depth| for exact s) accepted at the nominal
 // depth: the "triangulation of exact truth within 0.1 mm".
 inline constexpr double kMaxFitResidualM = 0.0001;
+// Pixels where the fit misses kMaxFitResidualM get no depth; a projector losing more than this
+// share of the pixels it lights at the nominal depth is refused.
+inline constexpr double kMaxFitMissedShare = 0.01;
 
 // Init-time tables for one projector–camera pair, in integers (buildTriangulationTables).
 // Numerics: s is Q16 (StripeQ16). den = (C' << 16) + D'·s with C', D' int32 (the per-pixel C, D
@@ -70,7 +73,7 @@ struct TriangulationTables {
   // sign(B·C − A·D) per pixel (+1 for a fitted one); 0 where the pixel has no ray or, with a
   // distorted projector, s(z) along it is not defined and monotone over the working range.
   std::vector<std::int8_t> sense;
-  // Distorted projector: the fit's largest |z_fit(s) − z| for exact s over the pixels whose
+  // Distorted projector: the fit's largest |z_fit(s) − z| for exact s over the pixels kept whose
   // point lands inside the projector image and the stripe sequence, at the nominal depth and
   // over the working range (17 depths, even in 1/z), metres; 0 for an undistorted projector.
   double nominalResidualM = 0.0;
@@ -81,7 +84,8 @@ struct TriangulationTables {
 // depthUnitM metres. A distorted projector's tables are fitted around nominalDepthM (the rig's
 // working distance; required then, ignored otherwise). Errors name the problem: indices,
 // depthUnitM or nominalDepthM ≤ 0, a degenerate pattern, a distorted projector whose fit misses
-// kMaxFitResidualM at the nominal depth (the message gives the measured residual).
+// kMaxFitResidualM at the nominal depth on more than kMaxFitMissedShare of the pixels it lights
+// (the message gives the share and the largest miss); fewer such pixels get no depth.
 [[nodiscard]] std::expected<TriangulationTables, std::string> buildTriangulationTables(
     const Rig& rig, int camera, int projector, double depthUnitM,
     std::optional<double> nominalDepthM = std::nullopt);
