@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "closed_form_optics.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/pattern_image.hpp"
 #include "smx/algo/stripe_code.hpp"
@@ -139,39 +140,9 @@ Vec3 onWall(const Ray& r, double z) {
   return r.o + (z - r.o.z()) / r.d.z() * r.d;
 }
 
-Mat3 rotationOf(const algo::DeviceModel& m) {
-  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.R.data());
-}
-
-Vec3 centreOf(const algo::DeviceModel& m) {
-  return -rotationOf(m).transpose() * Vec3(m.t[0], m.t[1], m.t[2]);
-}
-
-// Pinhole K plus Brown–Conrady (k1 k2 p1 p2 k3), as cv::projectPoints; `distort` false drops the
-// distortion.
-std::optional<std::array<double, 2>> projectPoint(const algo::DeviceModel& m, const Vec3& X,
-                                                  bool distort = true) {
-  const Vec3 x = rotationOf(m) * X + Vec3(m.t[0], m.t[1], m.t[2]);
-  if (!(x.z() > 0.0)) {
-    return std::nullopt;
-  }
-  const double a = x.x() / x.z();
-  const double b = x.y() / x.z();
-  const auto [k1, k2, p1, p2, k3] = distort ? m.dist : std::array<double, 5>{};
-  const double r2 = a * a + b * b;
-  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
-  const double xd = a * radial + 2.0 * p1 * a * b + p2 * (r2 + 2.0 * a * a);
-  const double yd = b * radial + p1 * (r2 + 2.0 * b * b) + 2.0 * p2 * a * b;
-  return std::array<double, 2>{m.K[0] * xd + m.K[2], m.K[4] * yd + m.K[5]};
-}
-
-double stripeFormula(const algo::Projector& p, double u, double v) {
-  const double a = p.pattern.angleDeg * std::numbers::pi / 180.0;
-  return ((u - (p.width - 1) / 2.0) * std::cos(a) + (v - (p.height - 1) / 2.0) * std::sin(a) -
-          p.pattern.offsetPx) /
-             p.pattern.stripePx +
-         99.0;
-}
+using test::centreOf;
+using test::projectPoint;
+using test::stripeFormula;
 
 // The projector pixel nearest (u, v), or nullopt outside the image or within 1e-4 px of the
 // line between two pixels (either may light the point).

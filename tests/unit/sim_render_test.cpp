@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "closed_form_optics.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/stripe_code.hpp"
 #include "smx/config/rig_json.hpp"
@@ -168,42 +169,10 @@ Ray cameraRay(const algo::DeviceModel& camera, int x, int y) {
           {r->direction[0], r->direction[1], r->direction[2]}};
 }
 
-Mat3 rotationOf(const algo::DeviceModel& m) {
-  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.R.data());
-}
-
-Vec3 toDevice(const algo::DeviceModel& m, const Vec3& X) {
-  return rotationOf(m) * X + Vec3(m.t[0], m.t[1], m.t[2]);
-}
-
-Vec3 centreOf(const algo::DeviceModel& m) {
-  return -rotationOf(m).transpose() * Vec3(m.t[0], m.t[1], m.t[2]);
-}
-
-// docs/rig-format.md: pinhole K plus Brown–Conrady (k1 k2 p1 p2 k3), as cv::projectPoints.
-std::optional<std::array<double, 2>> projectPoint(const algo::DeviceModel& m, const Vec3& X) {
-  const Vec3 x = toDevice(m, X);
-  if (!(x.z() > 0.0)) {
-    return std::nullopt;
-  }
-  const double a = x.x() / x.z();
-  const double b = x.y() / x.z();
-  const auto [k1, k2, p1, p2, k3] = m.dist;
-  const double r2 = a * a + b * b;
-  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
-  const double xd = a * radial + 2.0 * p1 * a * b + p2 * (r2 + 2.0 * a * a);
-  const double yd = b * radial + p1 * (r2 + 2.0 * b * b) + 2.0 * p2 * a * b;
-  return std::array<double, 2>{m.K[0] * xd + m.K[2], m.K[4] * yd + m.K[5]};
-}
-
-// docs/pattern.md.
-double stripeFormula(const algo::Projector& p, double u, double v) {
-  const double a = p.pattern.angleDeg * std::numbers::pi / 180.0;
-  return ((u - (p.width - 1) / 2.0) * std::cos(a) + (v - (p.height - 1) / 2.0) * std::sin(a) -
-          p.pattern.offsetPx) /
-             p.pattern.stripePx +
-         99.0;
-}
+using test::centreOf;
+using test::projectPoint;
+using test::stripeFormula;
+using test::toDevice;
 
 // Ray parameter of the first crossing with t > 0, every shape grown by `grow` metres (a negative
 // value shrinks it): comparing grown and shrunk shapes marks rays too close to an edge to judge.
