@@ -69,6 +69,12 @@ Result<void> validate(int width, int height, const DecodeParams& p) {
     return fail(Errc::kInvalidArgument,
                 "decode: maxGapPx 1 to 64, minSeparationQ8 0 to 16384, minCurveVotes >= 1");
   }
+  if (p.maxNeighbourDisagreePct < 0 || p.maxNeighbourDisagreePct > 100) {
+    return fail(Errc::kInvalidArgument, "decode: maxNeighbourDisagreePct must be 0 to 100");
+  }
+  if (p.maxGapRatioPct != 0 && (p.maxGapRatioPct < 101 || p.maxGapRatioPct > 400)) {
+    return fail(Errc::kInvalidArgument, "decode: maxGapRatioPct must be 0 (off) or 101 to 400");
+  }
   return {};
 }
 
@@ -146,7 +152,7 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   prepare(boundaries, directions);
   link(directions);
   vote();
-  joinCurves();
+  joinCurves(directions);
   smoothPositions(directions);
   fill(directions, stripe);
   return {};
@@ -342,7 +348,7 @@ void StripeDecoder::vote() {
 
 // Step 3. Union-find over touching boundary pixels of one class (parent = smaller index, path
 // halving), then a weighted Boyer–Moore majority per root and a second pass for its support.
-void StripeDecoder::joinCurves() {
+void StripeDecoder::joinCurves(ConstDirectionPlane d) {
   const auto find = [this](std::int32_t i) {
     while (parent_[static_cast<std::size_t>(i)] != i) {
       const std::int32_t up =
@@ -431,15 +437,24 @@ void StripeDecoder::joinCurves() {
       level_[i] = candidate_[r];
     }
   }
-  // The next layer: a curve's links should lead to decoded curves one level on either side.
-  // Per root, the links that do (weight_) and the links to decoded pixels that do not (total_);
-  // a curve whose links mostly disagree is dropped.
+  // The next layer: a curve's links should lead to decoded curves one level on either side, at
+  // about the same distance on both (a skipped or mislocated boundary makes one gap much longer
+  // than the other). Per root, the links that fit (weight_) and the links to decoded pixels that
+  // do not (total_); a curve with too large a share of misfits is dropped.
   for (std::size_t i = 0; i < code_.size(); ++i) {
     weight_[i] = 0;
     total_[i] = 0;
   }
-  const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
-    return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
+  const auto indexOf = [this](std::int32_t packed) {
+    return flat(packedX(packed), packedY(packed), width_);
+  };
+  const auto linkedLevel = [&](std::int32_t link) -> std::int32_t {
+    return link == kNone ? 0 : level_[indexOf(link)];
+  };
+  const auto positionOf = [this](std::size_t i) {
+    const auto x = static_cast<std::int32_t>(i % static_cast<std::size_t>(width_));
+    const auto y = static_cast<std::int32_t>(i / static_cast<std::size_t>(width_));
+    return PointQ8{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
   };
   for (std::size_t i = 0; i < code_.size(); ++i) {
     const std::int32_t level = level_[i];
@@ -449,16 +464,30 @@ void StripeDecoder::joinCurves() {
     const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
     const std::int32_t ahead = linkedLevel(next_[i]);
     const std::int32_t behind = linkedLevel(prev_[i]);
-    weight_[r] += (ahead == level + 1 ? 1 : 0) + (behind == level - 1 ? 1 : 0);
-    total_[r] +=
-        (ahead != 0 && ahead != level + 1 ? 1 : 0) + (behind != 0 && behind != level - 1 ? 1 : 0);
+    bool aheadFits = ahead == level + 1;
+    bool behindFits = behind == level - 1;
+    // Level 1 has no boundary behind it (behind = 0 fits): no gap to compare.
+    if (aheadFits && behindFits && behind != 0 && params_.maxGapRatioPct > 0) {
+      // A skipped boundary on one side makes that gap about twice the other; int64 products.
+      const std::size_t x = i % static_cast<std::size_t>(width_);
+      const std::size_t y = i / static_cast<std::size_t>(width_);
+      const Unit u = unitOf(units_[0], d.rowPtr(static_cast<int>(y))[x]);
+      const PointQ8 p = positionOf(i);
+      const std::int64_t gapAhead = along(p, positionOf(indexOf(next_[i])), u);
+      const std::int64_t gapBehind = along(positionOf(indexOf(prev_[i])), p, u);
+      aheadFits = 100 * gapAhead <= params_.maxGapRatioPct * gapBehind;
+      behindFits = 100 * gapBehind <= params_.maxGapRatioPct * gapAhead;
+    }
+    weight_[r] += (aheadFits ? 1 : 0) + (behindFits ? 1 : 0);
+    total_[r] += (ahead != 0 && !aheadFits ? 1 : 0) + (behind != 0 && !behindFits ? 1 : 0);
   }
   for (std::size_t i = 0; i < code_.size(); ++i) {
     if (level_[i] == 0) {
       continue;
     }
     const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
-    if (total_[r] > weight_[r]) {
+    if (std::int64_t{100} * total_[r] >
+        std::int64_t{params_.maxNeighbourDisagreePct} * (total_[r] + weight_[r])) {
       level_[i] = 0;
     } else {
       ++stats_.decodedPixels;
