@@ -94,6 +94,8 @@ Result<void> StripeDecoder::carve(Carver& carver) {
   step(carveSpan(carver, shift_, pixels));
   step(carveSpan(carver, next_, pixels));
   step(carveSpan(carver, prev_, pixels));
+  step(carveSpan(carver, gapNext_, pixels));
+  step(carveSpan(carver, gapPrev_, pixels));
   step(carveSpan(carver, parent_, pixels));
   step(carveSpan(carver, weight_, pixels));
   step(carveSpan(carver, total_, pixels));
@@ -152,7 +154,7 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   prepare(boundaries, directions);
   link(directions);
   vote();
-  joinCurves(directions);
+  joinCurves();
   smoothPositions(directions);
   fill(directions, stripe);
   return {};
@@ -185,17 +187,22 @@ namespace {
 // 2×2 pixels around the sample are looked at (a 1-pixel-thick oblique curve can pass between
 // nearest-pixel samples), each 2×2 block once. `distance(x, y, i)` returns where the boundary
 // at that pixel lies along the walk (Q8), or −1 to pass it over; the nearest accepted pixel of
-// the first block that has one wins, packed (y << 16 | x), else kNone.
+// the first block that has one wins, packed (y << 16 | x) with its distance, else kNone.
+struct Hit {
+  std::int32_t at;
+  std::int32_t distance;
+};
+
 template <class Distance>
-std::int32_t walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start,
-                  std::int32_t sx, std::int32_t sy, int first, int last, Distance distance) {
+Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start, std::int32_t sx,
+         std::int32_t sy, int first, int last, Distance distance) {
   int lastX0 = -2;
   int lastY0 = -2;
   for (int k = first; k <= last; ++k) {
     const int x0 = (start.x + k * sx) >> 8;
     const int y0 = (start.y + k * sy) >> 8;
     if (x0 < -1 || y0 < -1 || x0 >= width || y0 >= height) {
-      return kNone;
+      return {kNone, 0};
     }
     if (x0 == lastX0 && y0 == lastY0) {
       continue;
@@ -221,10 +228,10 @@ std::int32_t walk(std::span<const std::uint8_t> code, int width, int height, Poi
       }
     }
     if (best != kNone) {
-      return best;
+      return {best, bestDistance};
     }
   }
-  return kNone;
+  return {kNone, 0};
 }
 
 }  // namespace
@@ -256,8 +263,11 @@ void StripeDecoder::link(ConstDirectionPlane d) {
           const std::int32_t dist = sign * along(p, qp, u);
           return dist >= params_.minSeparationQ8 ? dist : -1;
         };
-        (sign > 0 ? next_ : prev_)[i] = walk(code_, width_, height_, p, sign * (u.x >> 7),
-                                             sign * (u.y >> 7), 1, steps, distance);
+        const Hit hit = walk(code_, width_, height_, p, sign * (u.x >> 7), sign * (u.y >> 7), 1,
+                             steps, distance);
+        (sign > 0 ? next_ : prev_)[i] = hit.at;
+        // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
+        (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
       }
     }
   }
@@ -348,7 +358,7 @@ void StripeDecoder::vote() {
 
 // Step 3. Union-find over touching boundary pixels of one class (parent = smaller index, path
 // halving), then a weighted Boyer–Moore majority per root and a second pass for its support.
-void StripeDecoder::joinCurves(ConstDirectionPlane d) {
+void StripeDecoder::joinCurves() {
   const auto find = [this](std::int32_t i) {
     while (parent_[static_cast<std::size_t>(i)] != i) {
       const std::int32_t up =
@@ -445,17 +455,10 @@ void StripeDecoder::joinCurves(ConstDirectionPlane d) {
     weight_[i] = 0;
     total_[i] = 0;
   }
-  const auto indexOf = [this](std::int32_t packed) {
-    return flat(packedX(packed), packedY(packed), width_);
+  const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
+    return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
   };
-  const auto linkedLevel = [&](std::int32_t link) -> std::int32_t {
-    return link == kNone ? 0 : level_[indexOf(link)];
-  };
-  const auto positionOf = [this](std::size_t i) {
-    const auto x = static_cast<std::int32_t>(i % static_cast<std::size_t>(width_));
-    const auto y = static_cast<std::int32_t>(i / static_cast<std::size_t>(width_));
-    return PointQ8{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
-  };
+  const std::int32_t ratio = params_.maxGapRatioPct;
   for (std::size_t i = 0; i < code_.size(); ++i) {
     const std::int32_t level = level_[i];
     if (level == 0) {
@@ -466,17 +469,11 @@ void StripeDecoder::joinCurves(ConstDirectionPlane d) {
     const std::int32_t behind = linkedLevel(prev_[i]);
     bool aheadFits = ahead == level + 1;
     bool behindFits = behind == level - 1;
-    // Level 1 has no boundary behind it (behind = 0 fits): no gap to compare.
-    if (aheadFits && behindFits && behind != 0 && params_.maxGapRatioPct > 0) {
-      // A skipped boundary on one side makes that gap about twice the other; int64 products.
-      const std::size_t x = i % static_cast<std::size_t>(width_);
-      const std::size_t y = i / static_cast<std::size_t>(width_);
-      const Unit u = unitOf(units_[0], d.rowPtr(static_cast<int>(y))[x]);
-      const PointQ8 p = positionOf(i);
-      const std::int64_t gapAhead = along(p, positionOf(indexOf(next_[i])), u);
-      const std::int64_t gapBehind = along(positionOf(indexOf(prev_[i])), p, u);
-      aheadFits = 100 * gapAhead <= params_.maxGapRatioPct * gapBehind;
-      behindFits = 100 * gapBehind <= params_.maxGapRatioPct * gapAhead;
+    // Level 1 has no boundary behind it (behind = 0 fits): no gap to compare. The gaps are the
+    // links' distances along the axis (step 1); their products with ratio ≤ 400 fit in int32.
+    if (aheadFits && behindFits && behind != 0 && ratio > 0) {
+      aheadFits = 100 * std::int32_t{gapNext_[i]} <= ratio * gapPrev_[i];
+      behindFits = 100 * std::int32_t{gapPrev_[i]} <= ratio * gapNext_[i];
     }
     weight_[r] += (aheadFits ? 1 : 0) + (behindFits ? 1 : 0);
     total_[r] += (ahead != 0 && !aheadFits ? 1 : 0) + (behind != 0 && !behindFits ? 1 : 0);
@@ -564,7 +561,7 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
         return along(positionOf(qx, qy), here, u);
       };
       const std::int32_t q =
-          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind);
+          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind).at;
       if (q == kNone) {
         continue;
       }

@@ -91,7 +91,7 @@ class StripeDecoder {
   void prepare(ConstBoundaryPlane b, ConstDirectionPlane d);
   void link(ConstDirectionPlane d);
   void vote();
-  void joinCurves(ConstDirectionPlane d);
+  void joinCurves();
   void smoothPositions(ConstDirectionPlane d);
   void fill(ConstDirectionPlane d, StripePlane stripe);
 
@@ -111,6 +111,8 @@ class StripeDecoder {
   std::span<Shift> shift_;             // where the boundary lies
   std::span<std::int32_t> next_;       // linked boundary ahead: y << 16 | x, or −1
   std::span<std::int32_t> prev_;       // behind
+  std::span<std::int16_t> gapNext_;    // distance to the link ahead along the axis, Q8 px
+  std::span<std::int16_t> gapPrev_;    // behind
   std::span<std::int32_t> parent_;     // union-find over boundary pixels
   std::span<std::int32_t> weight_;     // per curve root: Boyer–Moore count, then support
   std::span<std::int32_t> total_;      // per curve root: all votes
