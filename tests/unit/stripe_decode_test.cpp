@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -41,20 +42,42 @@ struct Synthetic {
     directions.assign(static_cast<std::size_t>(width * height), raw);
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
-        const double sv = s(x, y);
-        const int k = static_cast<int>(std::floor(sv + 0.5));
-        const double deltaPx = (k - sv) * periodPx;
-        if (k < 1 || k >= stripe::kStripes || deltaPx < -0.5 || deltaPx >= 0.5) {
-          continue;
-        }
-        Boundary& b = at(x, y);
-        b.offset = static_cast<std::int16_t>(std::lround(deltaPx * 256));
-        b.transition = Boundary::code(
-            stripe::transitionBetween(stripe::kSequence[static_cast<std::size_t>(k - 1)],
-                                      stripe::kSequence[static_cast<std::size_t>(k)]));
-        b.confidence = 255;
+        place(x, y, s(x, y), [](int) { return true; });
       }
     }
+  }
+
+  // Moves boundary curve k to where s = k + stripes: a curve of the right level in the wrong
+  // place, as a mislocated or a skipped boundary leaves it.
+  void displace(int k, double stripes) {
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (at(x, y).present() && std::floor(s(x, y) + 0.5) == k) {
+          at(x, y) = Boundary{};
+        }
+      }
+    }
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        place(x, y, s(x, y) - stripes, [k](int level) { return level == k; });
+      }
+    }
+  }
+
+  // The boundary at (x, y) when the level nearest to `sv` lies within [−½, ½) px of its centre.
+  template <class Keep>
+  void place(int x, int y, double sv, Keep keep) {
+    const int k = static_cast<int>(std::floor(sv + 0.5));
+    const double deltaPx = (k - sv) * periodPx;
+    if (k < 1 || k >= stripe::kStripes || deltaPx < -0.5 || deltaPx >= 0.5 || !keep(k)) {
+      return;
+    }
+    Boundary& b = at(x, y);
+    b.offset = static_cast<std::int16_t>(std::lround(deltaPx * 256));
+    b.transition =
+        Boundary::code(stripe::transitionBetween(stripe::kSequence[static_cast<std::size_t>(k - 1)],
+                                                 stripe::kSequence[static_cast<std::size_t>(k)]));
+    b.confidence = 255;
   }
 
   [[nodiscard]] ConstBoundaryPlane boundaryPlane() const {
@@ -224,6 +247,50 @@ TEST(StripeDecode, CurvesOutvoteMisclassifiedPixelsThatScanLinesGetWrong) {
   EXPECT_GE(withCurves.decoded, withLines.decoded);
 }
 
+TEST(StripeDecode, DropsACurveSpacedUnlikeItsNeighbours) {
+  // Given a clean pattern (period 5 px) in which boundary 40 lies 0.45 stripe ahead of its place
+  // (gaps of 1.45 and 0.55 periods on either side; the colours still chain)
+  Synthetic syn;
+  syn.angleDeg = 20;
+  syn.draw();
+  const Decoded clean = decode(syn);
+  const int moved = 40;
+  syn.displace(moved, 0.45);
+  // When decoded with the spacing check and without it
+  DecodeParams unchecked;
+  unchecked.maxGapRatioPct = 0;
+  const Decoded d = decode(syn);
+  const Decoded off = decode(syn, unchecked);
+  // Then without it the stripes beside the curve are off by up to 0.45 stripe; with it no
+  // coordinate is off by more than 0.1 stripe from the truth
+  const auto wrongBy = [&](const Decoded& out, double tolerance) {
+    int n = 0;
+    for (int y = 0; y < syn.height; ++y) {
+      for (int x = 0; x < syn.width; ++x) {
+        const StripeQ16 v = out.stripe[static_cast<std::size_t>(y * syn.width + x)];
+        n += v != kNoStripe && std::abs(v / 65536.0 - syn.s(x, y)) > tolerance ? 1 : 0;
+      }
+    }
+    return n;
+  };
+  EXPECT_GT(wrongBy(off, 0.1), 100);
+  EXPECT_EQ(wrongBy(d, 0.1), 0);
+  // and the stripes two or more away from the moved curve keep every coordinate they had
+  const auto decodedAway = [&](const Decoded& out) {
+    int n = 0;
+    for (int y = 0; y < syn.height; ++y) {
+      for (int x = 0; x < syn.width; ++x) {
+        const double sv = syn.s(x, y);
+        const bool away = sv < moved - 2 || sv >= moved + 2;
+        n += away && out.stripe[static_cast<std::size_t>(y * syn.width + x)] != kNoStripe ? 1 : 0;
+      }
+    }
+    return n;
+  };
+  EXPECT_EQ(decodedAway(d), decodedAway(clean));
+  EXPECT_LT(d.stats.decodedPixels, clean.stats.decodedPixels);
+}
+
 // Boundary positions with independent noise (±0.25 px uniform along the axis): averaging each
 // along its curve (positionRadiusPx 2) brings the coordinate closer to the truth than the raw
 // positions (0).
@@ -293,6 +360,14 @@ TEST(StripeDecode, RejectsPlanesOfAnotherSizeAndBadParameters) {
   DecodeParams bad;
   bad.maxGapPx = 0;
   EXPECT_FALSE(StripeDecoder::workspaceBytes(syn.width, syn.height, bad));
+  for (const auto& [field, value] : {std::pair{&DecodeParams::maxNeighbourDisagreePct, 101},
+                                     std::pair{&DecodeParams::maxGapRatioPct, 99}}) {
+    DecodeParams p;
+    p.*field = value;
+    const auto sized = StripeDecoder::workspaceBytes(syn.width, syn.height, p);
+    ASSERT_FALSE(sized) << value;
+    EXPECT_EQ(sized.error().code, Errc::kInvalidArgument);
+  }
 }
 
 }  // namespace

@@ -69,6 +69,12 @@ Result<void> validate(int width, int height, const DecodeParams& p) {
     return fail(Errc::kInvalidArgument,
                 "decode: maxGapPx 1 to 64, minSeparationQ8 0 to 16384, minCurveVotes >= 1");
   }
+  if (p.maxNeighbourDisagreePct < 0 || p.maxNeighbourDisagreePct > 100) {
+    return fail(Errc::kInvalidArgument, "decode: maxNeighbourDisagreePct must be 0 to 100");
+  }
+  if (p.maxGapRatioPct != 0 && (p.maxGapRatioPct < 101 || p.maxGapRatioPct > 400)) {
+    return fail(Errc::kInvalidArgument, "decode: maxGapRatioPct must be 0 (off) or 101 to 400");
+  }
   return {};
 }
 
@@ -88,6 +94,8 @@ Result<void> StripeDecoder::carve(Carver& carver) {
   step(carveSpan(carver, shift_, pixels));
   step(carveSpan(carver, next_, pixels));
   step(carveSpan(carver, prev_, pixels));
+  step(carveSpan(carver, gapNext_, pixels));
+  step(carveSpan(carver, gapPrev_, pixels));
   step(carveSpan(carver, parent_, pixels));
   step(carveSpan(carver, weight_, pixels));
   step(carveSpan(carver, total_, pixels));
@@ -179,17 +187,22 @@ namespace {
 // 2×2 pixels around the sample are looked at (a 1-pixel-thick oblique curve can pass between
 // nearest-pixel samples), each 2×2 block once. `distance(x, y, i)` returns where the boundary
 // at that pixel lies along the walk (Q8), or −1 to pass it over; the nearest accepted pixel of
-// the first block that has one wins, packed (y << 16 | x), else kNone.
+// the first block that has one wins, packed (y << 16 | x) with its distance, else kNone.
+struct Hit {
+  std::int32_t at;
+  std::int32_t distance;
+};
+
 template <class Distance>
-std::int32_t walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start,
-                  std::int32_t sx, std::int32_t sy, int first, int last, Distance distance) {
+Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start, std::int32_t sx,
+         std::int32_t sy, int first, int last, Distance distance) {
   int lastX0 = -2;
   int lastY0 = -2;
   for (int k = first; k <= last; ++k) {
     const int x0 = (start.x + k * sx) >> 8;
     const int y0 = (start.y + k * sy) >> 8;
     if (x0 < -1 || y0 < -1 || x0 >= width || y0 >= height) {
-      return kNone;
+      return {kNone, 0};
     }
     if (x0 == lastX0 && y0 == lastY0) {
       continue;
@@ -215,10 +228,10 @@ std::int32_t walk(std::span<const std::uint8_t> code, int width, int height, Poi
       }
     }
     if (best != kNone) {
-      return best;
+      return {best, bestDistance};
     }
   }
-  return kNone;
+  return {kNone, 0};
 }
 
 }  // namespace
@@ -250,8 +263,11 @@ void StripeDecoder::link(ConstDirectionPlane d) {
           const std::int32_t dist = sign * along(p, qp, u);
           return dist >= params_.minSeparationQ8 ? dist : -1;
         };
-        (sign > 0 ? next_ : prev_)[i] = walk(code_, width_, height_, p, sign * (u.x >> 7),
-                                             sign * (u.y >> 7), 1, steps, distance);
+        const Hit hit = walk(code_, width_, height_, p, sign * (u.x >> 7), sign * (u.y >> 7), 1,
+                             steps, distance);
+        (sign > 0 ? next_ : prev_)[i] = hit.at;
+        // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
+        (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
       }
     }
   }
@@ -431,9 +447,10 @@ void StripeDecoder::joinCurves() {
       level_[i] = candidate_[r];
     }
   }
-  // The next layer: a curve's links should lead to decoded curves one level on either side.
-  // Per root, the links that do (weight_) and the links to decoded pixels that do not (total_);
-  // a curve whose links mostly disagree is dropped.
+  // The next layer: a curve's links should lead to decoded curves one level on either side, at
+  // about the same distance on both (a skipped or mislocated boundary makes one gap much longer
+  // than the other). Per root, the links that fit (weight_) and the links to decoded pixels that
+  // do not (total_); a curve with too large a share of misfits is dropped.
   for (std::size_t i = 0; i < code_.size(); ++i) {
     weight_[i] = 0;
     total_[i] = 0;
@@ -441,6 +458,7 @@ void StripeDecoder::joinCurves() {
   const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
     return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
   };
+  const std::int32_t ratio = params_.maxGapRatioPct;
   for (std::size_t i = 0; i < code_.size(); ++i) {
     const std::int32_t level = level_[i];
     if (level == 0) {
@@ -449,16 +467,24 @@ void StripeDecoder::joinCurves() {
     const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
     const std::int32_t ahead = linkedLevel(next_[i]);
     const std::int32_t behind = linkedLevel(prev_[i]);
-    weight_[r] += (ahead == level + 1 ? 1 : 0) + (behind == level - 1 ? 1 : 0);
-    total_[r] +=
-        (ahead != 0 && ahead != level + 1 ? 1 : 0) + (behind != 0 && behind != level - 1 ? 1 : 0);
+    bool aheadFits = ahead == level + 1;
+    bool behindFits = behind == level - 1;
+    // Level 1 has no boundary behind it (behind = 0 fits): no gap to compare. The gaps are the
+    // links' distances along the axis (step 1); their products with ratio ≤ 400 fit in int32.
+    if (aheadFits && behindFits && behind != 0 && ratio > 0) {
+      aheadFits = 100 * std::int32_t{gapNext_[i]} <= ratio * gapPrev_[i];
+      behindFits = 100 * std::int32_t{gapPrev_[i]} <= ratio * gapNext_[i];
+    }
+    weight_[r] += (aheadFits ? 1 : 0) + (behindFits ? 1 : 0);
+    total_[r] += (ahead != 0 && !aheadFits ? 1 : 0) + (behind != 0 && !behindFits ? 1 : 0);
   }
   for (std::size_t i = 0; i < code_.size(); ++i) {
     if (level_[i] == 0) {
       continue;
     }
     const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
-    if (total_[r] > weight_[r]) {
+    if (std::int64_t{100} * total_[r] >
+        std::int64_t{params_.maxNeighbourDisagreePct} * (total_[r] + weight_[r])) {
       level_[i] = 0;
     } else {
       ++stats_.decodedPixels;
@@ -535,7 +561,7 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
         return along(positionOf(qx, qy), here, u);
       };
       const std::int32_t q =
-          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind);
+          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind).at;
       if (q == kNone) {
         continue;
       }

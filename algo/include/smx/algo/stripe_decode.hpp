@@ -24,9 +24,10 @@
 //      the curve's level is the weighted majority (Boyer–Moore, > half the votes, at least
 //      minCurveVotes) of its pixels' levels, and it is given to every pixel of the curve, voted
 //      or not; a pixel whose own votes (≥ 2) contradict its curve is dropped; then a curve whose
-//      links lead more often to decoded boundaries of other levels than to its neighbours' (level
-//      ± 1) is dropped; each decoded boundary's position becomes the mean over its level's pixels
-//      within positionRadiusPx (noise along a curve is independent, the curve locally straight);
+//      links disagree too often (lead to decoded boundaries of other levels than level ± 1, or
+//      to a gap unlike the one on the other side) is dropped; each decoded boundary's position
+//      becomes the mean over its level's pixels within positionRadiusPx (noise along a curve is
+//      independent, the curve locally straight);
 //   4. dense coordinate: each pixel walks back along −axis to the nearest boundary; when that
 //      boundary (level k) is decoded and its forward link holds level k + 1 beyond the pixel,
 //      s = k + (distance from the first) / (distance between the two), both measured along the
@@ -37,8 +38,16 @@ struct DecodeParams {
   int maxGapPx = 12;          // link search distance along the axis (≈ 2.5 stripe periods)
   int minSeparationQ8 = 192;  // a linked boundary lies at least this far along the axis (Q8 px)
   int minCurveVotes = 8;      // a curve's level needs this many agreeing windows (over its pixels)
-  int positionRadiusPx = 2;   // boundary positions averaged along their curve (0: off)
-  bool curves = true;         // step 3 (off: each pixel is a curve of its own)
+  // A decoded curve is dropped when more than this share of its links to decoded boundaries
+  // disagree with it (0…100). 33 keeps a curve whose neighbour on one side is wrong along up to
+  // two thirds of it; a curve a stripe off has nearly all its links against it.
+  int maxNeighbourDisagreePct = 33;
+  // A link to level ± 1 disagrees when its gap along the axis exceeds this share of the gap on
+  // the other side (0: off, else 101…400). 150 lies between an even spacing (100) and a skipped
+  // boundary (200); a curve moved by a fifth of the local period reaches it.
+  int maxGapRatioPct = 150;
+  int positionRadiusPx = 2;  // boundary positions averaged along their curve (0: off)
+  bool curves = true;        // step 3 (off: each pixel is a curve of its own)
 };
 
 // Counts of the last run, for evaluation and the debug output.
@@ -102,6 +111,8 @@ class StripeDecoder {
   std::span<Shift> shift_;             // where the boundary lies
   std::span<std::int32_t> next_;       // linked boundary ahead: y << 16 | x, or −1
   std::span<std::int32_t> prev_;       // behind
+  std::span<std::int16_t> gapNext_;    // distance to the link ahead along the axis, Q8 px
+  std::span<std::int16_t> gapPrev_;    // behind
   std::span<std::int32_t> parent_;     // union-find over boundary pixels
   std::span<std::int32_t> weight_;     // per curve root: Boyer–Moore count, then support
   std::span<std::int32_t> total_;      // per curve root: all votes
