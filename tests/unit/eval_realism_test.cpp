@@ -269,24 +269,28 @@ TEST(RealismRuns, ARigThePipelineRefusesIsReportedWithItsReason) {
   EXPECT_TRUE(worstRuns(runs, 5).empty());
 }
 
-// A hand-built scored frame, 80 × 12, in five zones of 16 columns, each built to meet one cause
+// A hand-built scored frame, 144 × 12, in six zones of 24 columns, each built to meet one cause
 // first: A lit by projector 0 alone with stripes 2.8 px wide (narrow, and single too); B lit by
 // projector 0 alone, 5 px (single); C lit by both, 5 px, a flat grey image (dim); D lit by both,
 // 5 px, a column checker, a plane 80° from the camera axis (grazing); E as D on a fronto-parallel
-// plane (other). Each zone's scored pixels (columns 5–10, rows 4–7: 24) carry a known number of
-// gross depths and then of missing ones.
-constexpr int kZoneW = 16;
-constexpr int kZones = 5;
+// plane (other); F as E with a depth step 3 columns right of its scored pixels (edge). Each
+// zone's scored pixels (columns 9–14, rows 4–7: 24), more than 8 px from the steps at D's sides,
+// carry a known number of gross depths and then of missing ones.
+constexpr int kZoneW = 24;
+constexpr int kZones = 6;
 constexpr int kAttrW = kZoneW * kZones;
 constexpr int kAttrH = 12;
-constexpr std::array kGrossPerZone{3, 2, 1, 4, 5};
-constexpr std::array kMissingPerZone{2, 3, 4, 6, 1};
+// Zones A–F; E (other) comes before F (edge), unlike the causes.
+constexpr std::array kGrossPerZone{3, 2, 1, 4, 5, 6};
+constexpr std::array kMissingPerZone{2, 3, 4, 6, 1, 5};
+constexpr std::array kZoneCause{Cause::kNarrow,  Cause::kSingle, Cause::kDim,
+                                Cause::kGrazing, Cause::kOther,  Cause::kEdge};
 constexpr double kFx = 1000.0;
-constexpr double kCx = 40.0;
+constexpr double kCx = 72.0;
 
 bool scored(int x, int y) {
   const int u = x % kZoneW;
-  return u >= 5 && u <= 10 && y >= 4 && y <= 7;
+  return u >= 9 && u <= 14 && y >= 4 && y <= 7;
 }
 
 algo::DeviceModel device(double centreX) {
@@ -335,7 +339,8 @@ AttributionFixture attributionFixture() {
         f.image.pixels[i] = {v, v, v};
       }
       // z − tan 80°·X = 1 with X = z·(x − cx) / fx: a plane whose normal is 80° off the axis.
-      const double z = zone == 3 ? 1.0 / (1.0 - (tan80 * (x - kCx) / kFx)) : 1.0;
+      double z = zone == 3 ? 1.0 / (1.0 - (tan80 * (x - kCx) / kFx)) : 1.0;
+      z = zone == 5 && x % kZoneW >= 17 ? 1.2 : z;
       f.depth.pixels[i] = static_cast<float>(z);
       a.merged.pixels[i] = static_cast<std::uint16_t>(std::lround(z / algo::kDefaultDepthUnitM));
     }
@@ -367,30 +372,39 @@ TEST(RealismAttribution, CountsPerCauseMatchTheConstructedFrame) {
   const auto fx = attributionFixture();
   const auto bit = [](Cause c) { return 1U << static_cast<unsigned>(c); };
   const std::array<unsigned, kZones> conditions{bit(Cause::kNarrow) | bit(Cause::kSingle),
-                                                bit(Cause::kSingle), bit(Cause::kDim),
-                                                bit(Cause::kGrazing), 0U};
+                                                bit(Cause::kSingle),
+                                                bit(Cause::kDim),
+                                                bit(Cause::kGrazing),
+                                                0U,
+                                                bit(Cause::kEdge)};
+  const Mask nearEdge = discontinuityBand(fx.frame.depth.view(), kNearEdgePx);
   for (int zone = 0; zone < kZones; ++zone) {
-    EXPECT_EQ(pixelConditions(fx.frame, 0, (zone * kZoneW) + 7, 5),
-              conditions[static_cast<std::size_t>(zone)])
-        << "zone " << zone;
+    for (int x = zone * kZoneW; x < (zone + 1) * kZoneW; ++x) {
+      if (scored(x, 5)) {
+        EXPECT_EQ(pixelConditions(fx.frame, 0, nearEdge, x, 5),
+                  conditions[static_cast<std::size_t>(zone)])
+            << "zone " << zone << ", column " << x;
+      }
+    }
   }
   const Attribution a = attributeRun(fx.frame, 0, fx.merged.view(), fx.region, fx.region);
-  for (std::size_t c = 0; c < kCauses; ++c) {
-    SCOPED_TRACE(causeName(static_cast<Cause>(c)));
+  for (std::size_t zone = 0; zone < kZones; ++zone) {
+    const auto c = static_cast<std::size_t>(kZoneCause[zone]);
+    SCOPED_TRACE(causeName(kZoneCause[zone]));
     EXPECT_EQ(a.outsideBand[c].region, 24);
-    EXPECT_EQ(a.outsideBand[c].gross, kGrossPerZone[c]);
-    EXPECT_EQ(a.outsideBand[c].valid, 24 - kMissingPerZone[c]);
-    EXPECT_EQ(a.resolvable[c].missing(), kMissingPerZone[c]);
+    EXPECT_EQ(a.outsideBand[c].gross, kGrossPerZone[zone]);
+    EXPECT_EQ(a.outsideBand[c].valid, 24 - kMissingPerZone[zone]);
+    EXPECT_EQ(a.resolvable[c].missing(), kMissingPerZone[zone]);
   }
   // Single also holds in zone A, where narrow comes first.
   EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].region, 48);
   EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].gross, 5);
-  EXPECT_NEAR(grossShare(a, Cause::kGrazing), 4.0 / 15.0, 1e-12);
-  EXPECT_NEAR(missingShare(a, Cause::kDim), 4.0 / 16.0, 1e-12);
-  // 120 pixels, 104 with depth, 15 gross; zones A and B (single) hold 43 valid, 5 gross.
-  EXPECT_NEAR(grossRateWithout(a, std::nullopt), 15.0 / 104.0, 1e-12);
-  EXPECT_NEAR(grossRateWithout(a, Cause::kSingle), 10.0 / 61.0, 1e-12);
-  EXPECT_NEAR(completenessWithout(a, Cause::kNarrow), 82.0 / 96.0, 1e-12);
+  EXPECT_NEAR(grossShare(a, Cause::kGrazing), 4.0 / 21.0, 1e-12);
+  EXPECT_NEAR(missingShare(a, Cause::kDim), 4.0 / 21.0, 1e-12);
+  // 144 pixels, 123 with depth, 21 gross; zones A and B (single) hold 43 valid, 5 gross.
+  EXPECT_NEAR(grossRateWithout(a, std::nullopt), 21.0 / 123.0, 1e-12);
+  EXPECT_NEAR(grossRateWithout(a, Cause::kSingle), 16.0 / 80.0, 1e-12);
+  EXPECT_NEAR(completenessWithout(a, Cause::kNarrow), 101.0 / 120.0, 1e-12);
   EXPECT_NEAR(grossRateWithout(a, Cause::kOther), 5.0 / 23.0, 1e-12);
 }
 
@@ -401,8 +415,8 @@ TEST(RealismAttribution, SumsAddTheCounts) {
   const std::array runs{a, a};
   const Attribution s = sumAttributions(runs);
   EXPECT_EQ(s.outsideBand[1].gross, 2 * kGrossPerZone[1]);
-  EXPECT_EQ(s.resolvableWith[0].region, 48);
-  EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 10.0 / 61.0, 1e-12);
+  EXPECT_EQ(s.resolvableWith[0].region, 2 * 24);
+  EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 16.0 / 80.0, 1e-12);
 }
 
 // The fixed-seed CI subset: the first 12 cases as `stripemux eval --only realism` renders them

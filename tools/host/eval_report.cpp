@@ -450,12 +450,14 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
         "lighting projector's stripes are under "
      << fixed(eval::kNarrowStripePx, 1)
      << " px wide in the camera (truth stripe gradient); **single** one projector lights it; "
-        "**dim** in the camera image's "
-     << 2 * eval::kDimWindowRadiusPx + 1 << " × " << 2 * eval::kDimWindowRadiusPx + 1
-     << " window around it every colour channel spans under " << eval::kDimContrastDn
-     << " DN; **grazing** the truth normal is more than " << fixed(eval::kGrazingDeg, 0)
-     << "° from the camera ray or from every lighting projector's ray; **other** none of "
-        "these. Shares in % as narrow / single / dim / grazing / other.\n\n"
+        "**dim** the camera image's 3 × 3 box means within "
+     << eval::kDimWindowRadiusPx << " px of it span under " << eval::kDimContrastDn
+     << " DN in every colour channel; **grazing** the truth normal is more than "
+     << fixed(eval::kGrazingDeg, 0)
+     << "° from the camera ray or from every lighting projector's ray; **edge** within "
+     << eval::kNearEdgePx
+     << " px of a depth discontinuity of the truth; **other** none of these. Shares in % as "
+        "narrow / single / dim / grazing / edge / other.\n\n"
         "| case | cam | gross outside band, px | shares | missing resolvable, px | shares |\n"
         "|---|---|---|---|---|---|\n";
   for (const auto& run : s.runs) {
@@ -476,7 +478,7 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
     md << "| " << eval::causeName(cause) << " | " << pct(eval::grossRateWithout(sum, cause), 3)
        << " | " << pct(eval::completenessWithout(sum, cause)) << " |\n";
   }
-  md << "| all four | " << pct(eval::grossRateWithout(sum, eval::Cause::kOther), 3) << " | "
+  md << "| all five | " << pct(eval::grossRateWithout(sum, eval::Cause::kOther), 3) << " | "
      << pct(eval::completenessWithout(sum, eval::Cause::kOther)) << " |\n\n";
 }
 

@@ -7,6 +7,7 @@
 
 #include "smx/algo/lens.hpp"
 #include "smx/eval/depth_eval.hpp"
+#include "smx/eval/realism_eval.hpp"
 
 namespace smx::eval {
 
@@ -53,26 +54,39 @@ bool narrow(const SimFrame& f, int x, int y) {
   return false;
 }
 
+std::array<int, 3> boxSum(const SimFrame& f, int x, int y) {
+  std::array<int, 3> sum{};
+  for (int yy = y - 1; yy <= y + 1; ++yy) {
+    for (int xx = x - 1; xx <= x + 1; ++xx) {
+      const auto& px = f.image.at(xx, yy);
+      sum[0] += px.r;
+      sum[1] += px.g;
+      sum[2] += px.b;
+    }
+  }
+  return sum;
+}
+
 bool dim(const SimFrame& f, int x, int y) {
   const int r = kDimWindowRadiusPx;
-  std::array<int, 3> lo{255, 255, 255};
-  std::array<int, 3> hi{0, 0, 0};
-  for (int yy = std::max(0, y - r); yy <= std::min(f.image.height - 1, y + r); ++yy) {
-    for (int xx = std::max(0, x - r); xx <= std::min(f.image.width - 1, x + r); ++xx) {
-      const auto& px = f.image.at(xx, yy);
-      const std::array<int, 3> c{px.r, px.g, px.b};
+  std::array<int, 3> lo{};
+  std::array<int, 3> hi{};
+  bool any = false;
+  for (int yy = std::max(1, y - r); yy <= std::min(f.image.height - 2, y + r); ++yy) {
+    for (int xx = std::max(1, x - r); xx <= std::min(f.image.width - 2, x + r); ++xx) {
+      const auto sum = boxSum(f, xx, yy);
       for (std::size_t i = 0; i < 3; ++i) {
-        lo[i] = std::min(lo[i], c[i]);
-        hi[i] = std::max(hi[i], c[i]);
+        lo[i] = any ? std::min(lo[i], sum[i]) : sum[i];
+        hi[i] = any ? std::max(hi[i], sum[i]) : sum[i];
       }
+      any = true;
     }
   }
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (hi[i] - lo[i] >= kDimContrastDn) {
-      return false;
-    }
-  }
-  return true;
+  // Sums of 9 pixels: compare against 9 × the threshold to stay in integers.
+  return std::ranges::none_of(std::array{0, 1, 2}, [&](int i) {
+    const auto c = static_cast<std::size_t>(i);
+    return hi[c] - lo[c] >= 9 * kDimContrastDn;
+  });
 }
 
 bool grazing(const SimFrame& f, int camera, int x, int y) {
@@ -160,13 +174,15 @@ const char* causeName(Cause c) {
       return "dim";
     case Cause::kGrazing:
       return "grazing";
+    case Cause::kEdge:
+      return "edge";
     case Cause::kOther:
       return "other";
   }
   return "other";
 }
 
-unsigned pixelConditions(const SimFrame& frame, int camera, int x, int y) {
+unsigned pixelConditions(const SimFrame& frame, int camera, const Mask& nearEdge, int x, int y) {
   unsigned bits = 0;
   if (narrow(frame, x, y)) {
     bits |= bit(Cause::kNarrow);
@@ -181,6 +197,9 @@ unsigned pixelConditions(const SimFrame& frame, int camera, int x, int y) {
   }
   if (grazing(frame, camera, x, y)) {
     bits |= bit(Cause::kGrazing);
+  }
+  if (nearEdge.at(x, y) != 0) {
+    bits |= bit(Cause::kEdge);
   }
   return bits;
 }
@@ -197,6 +216,7 @@ Cause firstCause(unsigned conditions) {
 Attribution attributeRun(const SimFrame& frame, int camera, algo::ConstDepthPlane merged,
                          const Mask& outsideBand, const Mask& resolvable, double depthUnitM) {
   Attribution a;
+  const Mask nearEdge = discontinuityBand(frame.depth.view(), kNearEdgePx);
   for (int y = 0; y < merged.height(); ++y) {
     for (int x = 0; x < merged.width(); ++x) {
       const bool inBand = outsideBand.at(x, y) != 0;
@@ -205,7 +225,7 @@ Attribution attributeRun(const SimFrame& frame, int camera, algo::ConstDepthPlan
       if ((!inBand && !inResolvable) || !std::isfinite(truth)) {
         continue;
       }
-      const unsigned bits = pixelConditions(frame, camera, x, y);
+      const unsigned bits = pixelConditions(frame, camera, nearEdge, x, y);
       const auto first = static_cast<std::size_t>(firstCause(bits));
       const bool valid = merged(x, y) != 0;
       const bool gross = valid && isGrossError(merged(x, y) * depthUnitM, truth);

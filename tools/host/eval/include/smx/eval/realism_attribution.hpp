@@ -18,15 +18,17 @@
 //   narrow   some projector lighting the pixel has stripes narrower than kNarrowStripePx in the
 //            camera (1 / |∇s| of the truth stripe plane, stripeGradient), or ∇s undefined there;
 //   single   exactly one projector lights the pixel (the merge has no second opinion);
-//   dim      the camera image's local contrast is low: over the (2·kDimWindowRadiusPx + 1)²
-//            window around the pixel (clipped to the image), max − min of a colour channel is
-//            below kDimContrastDn for every channel. The truth does not say which object (and
-//            so which albedo) a pixel sees, so dark and saturated albedo count here through the
-//            contrast they leave;
+//   dim      the camera image's local contrast is low: of the 3 × 3 box means centred within
+//            kDimWindowRadiusPx of the pixel (boxes inside the image), max − min of each colour
+//            channel is below kDimContrastDn (the box keeps sensor noise from passing for
+//            contrast). The truth does not say which object (and so which albedo) a pixel sees,
+//            so dark and saturated albedo count here through the contrast they leave;
 //   grazing  the truth surface normal (cross product of the central differences of the truth
 //            depth's camera-frame points, distortion removed; undefined where a neighbour has
 //            no depth) is more than kGrazingDeg from the camera ray, or from the ray of every
 //            projector lighting the pixel;
+//   edge     within kNearEdgePx (Euclidean) of a depth discontinuity of the truth (as
+//            discontinuityBand defines it, realism_eval.hpp);
 //   other    none of the above.
 //
 // Counted pixels: outside band = the run's outside-band region, missing = resolvable-region
@@ -34,19 +36,22 @@
 // pixel that meets a condition, whatever its place in the order.
 namespace smx::eval {
 
-enum class Cause : std::uint8_t { kNarrow, kSingle, kDim, kGrazing, kOther };
-inline constexpr int kCauses = 5;
-inline constexpr int kNamedCauses = 4;  // all but kOther
+enum class Cause : std::uint8_t { kNarrow, kSingle, kDim, kGrazing, kEdge, kOther };
+inline constexpr int kCauses = 6;
+inline constexpr int kNamedCauses = 5;  // all but kOther
 
 inline constexpr double kNarrowStripePx = 3.0;
-inline constexpr int kDimWindowRadiusPx = 4;
-inline constexpr int kDimContrastDn = 20;
+inline constexpr int kDimWindowRadiusPx = 3;
+inline constexpr int kDimContrastDn = 30;
 inline constexpr double kGrazingDeg = 70.0;
+inline constexpr int kNearEdgePx = 8;
 
 [[nodiscard]] const char* causeName(Cause c);
 
-// Bit (1 << Cause) per named condition the pixel meets.
-[[nodiscard]] unsigned pixelConditions(const SimFrame& frame, int camera, int x, int y);
+// Bit (1 << Cause) per named condition the pixel meets; nearEdge: discontinuityBand(truth depth,
+// kNearEdgePx).
+[[nodiscard]] unsigned pixelConditions(const SimFrame& frame, int camera, const Mask& nearEdge,
+                                       int x, int y);
 [[nodiscard]] Cause firstCause(unsigned conditions);
 
 // Pixels of one region with a finite truth depth: how many, how many have depth, how many of
