@@ -269,22 +269,23 @@ TEST(RealismRuns, ARigThePipelineRefusesIsReportedWithItsReason) {
   EXPECT_TRUE(worstRuns(runs, 5).empty());
 }
 
-// A hand-built scored frame, 144 × 12, in six zones of 24 columns, each built to meet one cause
+// A hand-built scored frame, 168 × 12, in seven zones of 24 columns, each built to meet one cause
 // first: A lit by projector 0 alone with stripes 2.8 px wide (narrow, and single too); B lit by
 // projector 0 alone, 5 px (single); C lit by both, 5 px, a flat grey image (dim); D lit by both,
 // 5 px, a column checker, a plane 80° from the camera axis (grazing); E as D on a fronto-parallel
-// plane (other); F as E with a depth step 3 columns right of its scored pixels (edge). Each
+// plane (other); F as E with a depth step 3 columns right of its scored pixels (edge); G as E
+// lit by a third projector too (triple). Each
 // zone's scored pixels (columns 9–14, rows 4–7: 24), more than 8 px from the steps at D's sides,
 // carry a known number of gross depths and then of missing ones.
 constexpr int kZoneW = 24;
-constexpr int kZones = 6;
+constexpr int kZones = 7;
 constexpr int kAttrW = kZoneW * kZones;
 constexpr int kAttrH = 12;
-// Zones A–F; E (other) comes before F (edge), unlike the causes.
-constexpr std::array kGrossPerZone{3, 2, 1, 4, 5, 6};
-constexpr std::array kMissingPerZone{2, 3, 4, 6, 1, 5};
-constexpr std::array kZoneCause{Cause::kNarrow,  Cause::kSingle, Cause::kDim,
-                                Cause::kGrazing, Cause::kOther,  Cause::kEdge};
+// Zones A–G; E (other) comes before F and G, unlike the causes.
+constexpr std::array kGrossPerZone{3, 2, 1, 4, 5, 6, 7};
+constexpr std::array kMissingPerZone{2, 3, 4, 6, 1, 5, 3};
+constexpr std::array kZoneCause{Cause::kNarrow, Cause::kSingle, Cause::kDim,   Cause::kGrazing,
+                                Cause::kOther,  Cause::kEdge,   Cause::kTriple};
 constexpr double kFx = 1000.0;
 constexpr double kCx = 72.0;
 
@@ -316,10 +317,11 @@ AttributionFixture attributionFixture() {
   f.rig.cameras.push_back({device(0.0)});
   f.rig.projectors.push_back({device(-0.1), {}});
   f.rig.projectors.push_back({device(0.1), {}});
+  f.rig.projectors.push_back({device(0.2), {}});
   f.image = OwnedPlane<algo::Rgb8>(kAttrW, kAttrH, algo::Rgb8{100, 100, 100});
   f.depth = OwnedPlane<float>(kAttrW, kAttrH, 1.0F);
-  f.lit.assign(2, OwnedPlane<std::uint8_t>(kAttrW, kAttrH, 0));
-  f.stripe.assign(2, OwnedPlane<float>(kAttrW, kAttrH, kNaN));
+  f.lit.assign(3, OwnedPlane<std::uint8_t>(kAttrW, kAttrH, 0));
+  f.stripe.assign(3, OwnedPlane<float>(kAttrW, kAttrH, kNaN));
   a.merged = OwnedPlane<std::uint16_t>(kAttrW, kAttrH, 0);
   a.region = Mask::filled(kAttrW, kAttrH, 0);
   const double tan80 = std::tan(80.0 * kDeg);
@@ -333,6 +335,10 @@ AttributionFixture attributionFixture() {
       if (zone >= 2) {
         f.lit[1].pixels[i] = 255;
         f.stripe[1].pixels[i] = static_cast<float>(10.0 + (x / 5.0));
+      }
+      if (zone == 6) {
+        f.lit[2].pixels[i] = 255;
+        f.stripe[2].pixels[i] = static_cast<float>(10.0 + (x / 5.0));
       }
       if (zone != 2) {
         const std::uint8_t v = x % 2 == 0 ? 200 : 0;
@@ -376,7 +382,8 @@ TEST(RealismAttribution, CountsPerCauseMatchTheConstructedFrame) {
                                                 bit(Cause::kDim),
                                                 bit(Cause::kGrazing),
                                                 0U,
-                                                bit(Cause::kEdge)};
+                                                bit(Cause::kEdge),
+                                                bit(Cause::kTriple)};
   const Mask nearEdge = discontinuityBand(fx.frame.depth.view(), kNearEdgePx);
   for (int zone = 0; zone < kZones; ++zone) {
     for (int x = zone * kZoneW; x < (zone + 1) * kZoneW; ++x) {
@@ -399,12 +406,12 @@ TEST(RealismAttribution, CountsPerCauseMatchTheConstructedFrame) {
   // Single also holds in zone A, where narrow comes first.
   EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].region, 48);
   EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].gross, 5);
-  EXPECT_NEAR(grossShare(a, Cause::kGrazing), 4.0 / 21.0, 1e-12);
-  EXPECT_NEAR(missingShare(a, Cause::kDim), 4.0 / 21.0, 1e-12);
-  // 144 pixels, 123 with depth, 21 gross; zones A and B (single) hold 43 valid, 5 gross.
-  EXPECT_NEAR(grossRateWithout(a, std::nullopt), 21.0 / 123.0, 1e-12);
-  EXPECT_NEAR(grossRateWithout(a, Cause::kSingle), 16.0 / 80.0, 1e-12);
-  EXPECT_NEAR(completenessWithout(a, Cause::kNarrow), 101.0 / 120.0, 1e-12);
+  EXPECT_NEAR(grossShare(a, Cause::kGrazing), 4.0 / 28.0, 1e-12);
+  EXPECT_NEAR(missingShare(a, Cause::kDim), 4.0 / 24.0, 1e-12);
+  // 168 pixels, 144 with depth, 28 gross; zones A and B (single) hold 43 valid, 5 gross.
+  EXPECT_NEAR(grossRateWithout(a, std::nullopt), 28.0 / 144.0, 1e-12);
+  EXPECT_NEAR(grossRateWithout(a, Cause::kSingle), 23.0 / 101.0, 1e-12);
+  EXPECT_NEAR(completenessWithout(a, Cause::kNarrow), 122.0 / 144.0, 1e-12);
   EXPECT_NEAR(grossRateWithout(a, Cause::kOther), 5.0 / 23.0, 1e-12);
 }
 
@@ -416,7 +423,7 @@ TEST(RealismAttribution, SumsAddTheCounts) {
   const Attribution s = sumAttributions(runs);
   EXPECT_EQ(s.outsideBand[1].gross, 2 * kGrossPerZone[1]);
   EXPECT_EQ(s.resolvableWith[0].region, 2 * 24);
-  EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 16.0 / 80.0, 1e-12);
+  EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 23.0 / 101.0, 1e-12);
 }
 
 // The fixed-seed CI subset: the first 12 cases as `stripemux eval --only realism` renders them

@@ -456,18 +456,19 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
      << fixed(eval::kGrazingDeg, 0)
      << "° from the camera ray or from every lighting projector's ray; **edge** within "
      << eval::kNearEdgePx
-     << " px of a depth discontinuity of the truth; **other** none of these. Shares in % as "
-        "narrow / single / dim / grazing / edge / other.\n\n"
-        "| case | cam | gross outside band, px | shares | missing resolvable, px | shares |\n"
-        "|---|---|---|---|---|---|\n";
+     << " px of a depth discontinuity of the truth; **triple** three projectors light it; "
+        "**other** none of these. Shares in % as narrow / single / dim / grazing / edge / "
+        "triple / other.\n\n"
+        "| case | cam | scene | gross outside band, px | shares | missing resolvable, px | "
+        "shares |\n|---|---|---|---|---|---|---|\n";
   for (const auto& run : s.runs) {
     if (!run.refused) {
-      md << attributionRow(
-          "| " + std::to_string(run.caseIndex) + " | cam" + std::to_string(run.camera),
-          run.attribution);
+      md << attributionRow("| " + std::to_string(run.caseIndex) + " | cam" +
+                               std::to_string(run.camera) + " | " + run.summary,
+                           run.attribution);
     }
   }
-  md << attributionRow("| **all** |", sum)
+  md << attributionRow("| **all** | |", sum)
      << "\nThe aggregate figures with every pixel meeting a condition removed (whatever its "
         "place in the order):\n\n"
         "| pixels removed | gross outside band | completeness, resolvable |\n|---|---|---|\n"
@@ -478,7 +479,7 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
     md << "| " << eval::causeName(cause) << " | " << pct(eval::grossRateWithout(sum, cause), 3)
        << " | " << pct(eval::completenessWithout(sum, cause)) << " |\n";
   }
-  md << "| all five | " << pct(eval::grossRateWithout(sum, eval::Cause::kOther), 3) << " | "
+  md << "| all six | " << pct(eval::grossRateWithout(sum, eval::Cause::kOther), 3) << " | "
      << pct(eval::completenessWithout(sum, eval::Cause::kOther)) << " |\n\n";
 }
 

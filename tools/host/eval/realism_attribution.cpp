@@ -176,6 +176,8 @@ const char* causeName(Cause c) {
       return "grazing";
     case Cause::kEdge:
       return "edge";
+    case Cause::kTriple:
+      return "triple";
     case Cause::kOther:
       return "other";
   }
@@ -200,6 +202,9 @@ unsigned pixelConditions(const SimFrame& frame, int camera, const Mask& nearEdge
   }
   if (nearEdge.at(x, y) != 0) {
     bits |= bit(Cause::kEdge);
+  }
+  if (lighting == 3) {
+    bits |= bit(Cause::kTriple);
   }
   return bits;
 }

@@ -29,6 +29,7 @@
 //            projector lighting the pixel;
 //   edge     within kNearEdgePx (Euclidean) of a depth discontinuity of the truth (as
 //            discontinuityBand defines it, realism_eval.hpp);
+//   triple   three projectors light the pixel (three stripe orientations to separate);
 //   other    none of the above.
 //
 // Counted pixels: outside band = the run's outside-band region, missing = resolvable-region
@@ -36,9 +37,9 @@
 // pixel that meets a condition, whatever its place in the order.
 namespace smx::eval {
 
-enum class Cause : std::uint8_t { kNarrow, kSingle, kDim, kGrazing, kEdge, kOther };
-inline constexpr int kCauses = 6;
-inline constexpr int kNamedCauses = 5;  // all but kOther
+enum class Cause : std::uint8_t { kNarrow, kSingle, kDim, kGrazing, kEdge, kTriple, kOther };
+inline constexpr int kCauses = 7;
+inline constexpr int kNamedCauses = 6;  // all but kOther
 
 inline constexpr double kNarrowStripePx = 3.0;
 inline constexpr int kDimWindowRadiusPx = 3;
