@@ -274,9 +274,9 @@ TEST(RealismRuns, ARigThePipelineRefusesIsReportedWithItsReason) {
 // projector 0 alone, 5 px (single); C lit by both, 5 px, a flat grey image (dim); D lit by both,
 // 5 px, a column checker, a plane 80° from the camera axis (grazing); E as D on a fronto-parallel
 // plane (other); F as E with a depth step 3 columns right of its scored pixels (edge); G as E
-// lit by a third projector too (triple). Each
-// zone's scored pixels (columns 9–14, rows 4–7: 24), more than 8 px from the steps at D's sides,
-// carry a known number of gross depths and then of missing ones.
+// lit by a third projector too (triple). Each zone's scored pixels (columns 9–14, rows 4–7:
+// 24), more than 8 px from every depth step but F's, carry a known number of gross depths and
+// then of missing ones.
 constexpr int kZoneW = 24;
 constexpr int kZones = 7;
 constexpr int kAttrW = kZoneW * kZones;
