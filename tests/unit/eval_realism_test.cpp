@@ -10,10 +10,12 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <vector>
 
 #include "smx/algo/lens.hpp"
+#include "smx/eval/realism_attribution.hpp"
 #include "smx/eval/realism_case.hpp"
 #include "smx/eval/realism_eval.hpp"
 #include "smx/eval/suite.hpp"
@@ -265,6 +267,163 @@ TEST(RealismRuns, ARigThePipelineRefusesIsReportedWithItsReason) {
     EXPECT_EQ(r.lit.regionPixels, 0);
   }
   EXPECT_TRUE(worstRuns(runs, 5).empty());
+}
+
+// A hand-built scored frame, 168 × 12, in seven zones of 24 columns, each built to meet one cause
+// first: A lit by projector 0 alone with stripes 2.8 px wide (narrow, and single too); B lit by
+// projector 0 alone, 5 px (single); C lit by both, 5 px, a flat grey image (dim); D lit by both,
+// 5 px, a column checker, a plane 80° from the camera axis (grazing); E as D on a fronto-parallel
+// plane (other); F as E with a depth step 3 columns right of its scored pixels (edge); G as E
+// lit by a third projector too (triple). Each zone's scored pixels (columns 9–14, rows 4–7:
+// 24), more than 8 px from every depth step but F's, carry a known number of gross depths and
+// then of missing ones.
+constexpr int kZoneW = 24;
+constexpr int kZones = 7;
+constexpr int kAttrW = kZoneW * kZones;
+constexpr int kAttrH = 12;
+// Zones A–G; E (other) comes before F and G, unlike the causes.
+constexpr std::array kGrossPerZone{3, 2, 1, 4, 5, 6, 7};
+constexpr std::array kMissingPerZone{2, 3, 4, 6, 1, 5, 3};
+constexpr std::array kZoneCause{Cause::kNarrow, Cause::kSingle, Cause::kDim,   Cause::kGrazing,
+                                Cause::kOther,  Cause::kEdge,   Cause::kTriple};
+constexpr double kFx = 1000.0;
+constexpr double kCx = 72.0;
+
+bool scored(int x, int y) {
+  const int u = x % kZoneW;
+  return u >= 9 && u <= 14 && y >= 4 && y <= 7;
+}
+
+algo::DeviceModel device(double centreX) {
+  algo::DeviceModel d;
+  d.width = kAttrW;
+  d.height = kAttrH;
+  d.K = {kFx, 0, kCx, 0, kFx, 6.0, 0, 0, 1};
+  d.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  d.t = {-centreX, 0, 0};
+  return d;
+}
+
+struct AttributionFixture {
+  SimFrame frame;
+  OwnedPlane<std::uint16_t> merged;
+  Mask region;
+};
+
+AttributionFixture attributionFixture() {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  AttributionFixture a;
+  SimFrame& f = a.frame;
+  f.rig.cameras.push_back({device(0.0)});
+  f.rig.projectors.push_back({device(-0.1), {}});
+  f.rig.projectors.push_back({device(0.1), {}});
+  f.rig.projectors.push_back({device(0.2), {}});
+  f.image = OwnedPlane<algo::Rgb8>(kAttrW, kAttrH, algo::Rgb8{100, 100, 100});
+  f.depth = OwnedPlane<float>(kAttrW, kAttrH, 1.0F);
+  f.lit.assign(3, OwnedPlane<std::uint8_t>(kAttrW, kAttrH, 0));
+  f.stripe.assign(3, OwnedPlane<float>(kAttrW, kAttrH, kNaN));
+  a.merged = OwnedPlane<std::uint16_t>(kAttrW, kAttrH, 0);
+  a.region = Mask::filled(kAttrW, kAttrH, 0);
+  const double tan80 = std::tan(80.0 * kDeg);
+  for (int y = 0; y < kAttrH; ++y) {
+    for (int x = 0; x < kAttrW; ++x) {
+      const auto i = static_cast<std::size_t>((y * kAttrW) + x);
+      const int zone = x / kZoneW;
+      f.lit[0].pixels[i] = 255;
+      f.stripe[0].pixels[i] = static_cast<float>(
+          x < kZoneW ? 10.0 + (x / 2.8) : 10.0 + (kZoneW / 2.8) + ((x - kZoneW) / 5.0));
+      if (zone >= 2) {
+        f.lit[1].pixels[i] = 255;
+        f.stripe[1].pixels[i] = static_cast<float>(10.0 + (x / 5.0));
+      }
+      if (zone == 6) {
+        f.lit[2].pixels[i] = 255;
+        f.stripe[2].pixels[i] = static_cast<float>(10.0 + (x / 5.0));
+      }
+      if (zone != 2) {
+        const std::uint8_t v = x % 2 == 0 ? 200 : 0;
+        f.image.pixels[i] = {v, v, v};
+      }
+      // z − tan 80°·X = 1 with X = z·(x − cx) / fx: a plane whose normal is 80° off the axis.
+      double z = zone == 3 ? 1.0 / (1.0 - (tan80 * (x - kCx) / kFx)) : 1.0;
+      z = zone == 5 && x % kZoneW >= 17 ? 1.2 : z;
+      f.depth.pixels[i] = static_cast<float>(z);
+      a.merged.pixels[i] = static_cast<std::uint16_t>(std::lround(z / algo::kDefaultDepthUnitM));
+    }
+  }
+  std::array<int, kZones> seen{};
+  for (int y = 0; y < kAttrH; ++y) {
+    for (int x = 0; x < kAttrW; ++x) {
+      if (!scored(x, y)) {
+        continue;
+      }
+      const auto zone = static_cast<std::size_t>(x / kZoneW);
+      const auto i = static_cast<std::size_t>((y * kAttrW) + x);
+      a.region.at(x, y) = 255;
+      const int k = seen[zone]++;
+      if (k < kGrossPerZone[zone]) {
+        a.merged.pixels[i] =
+            static_cast<std::uint16_t>(a.merged.pixels[i] + std::lround(0.05 / 1e-4));
+      } else if (k < kGrossPerZone[zone] + kMissingPerZone[zone]) {
+        a.merged.pixels[i] = 0;
+      }
+    }
+  }
+  return a;
+}
+
+// Given the five-zone frame, then every zone's pixels meet exactly the conditions it was built
+// with, and the counts per first cause are the zone's gross and missing pixels.
+TEST(RealismAttribution, CountsPerCauseMatchTheConstructedFrame) {
+  const auto fx = attributionFixture();
+  const auto bit = [](Cause c) { return 1U << static_cast<unsigned>(c); };
+  const std::array<unsigned, kZones> conditions{bit(Cause::kNarrow) | bit(Cause::kSingle),
+                                                bit(Cause::kSingle),
+                                                bit(Cause::kDim),
+                                                bit(Cause::kGrazing),
+                                                0U,
+                                                bit(Cause::kEdge),
+                                                bit(Cause::kTriple)};
+  const Mask nearEdge = discontinuityBand(fx.frame.depth.view(), kNearEdgePx);
+  for (int zone = 0; zone < kZones; ++zone) {
+    for (int x = zone * kZoneW; x < (zone + 1) * kZoneW; ++x) {
+      if (scored(x, 5)) {
+        EXPECT_EQ(pixelConditions(fx.frame, 0, nearEdge, x, 5),
+                  conditions[static_cast<std::size_t>(zone)])
+            << "zone " << zone << ", column " << x;
+      }
+    }
+  }
+  const Attribution a = attributeRun(fx.frame, 0, fx.merged.view(), fx.region, fx.region);
+  for (std::size_t zone = 0; zone < kZones; ++zone) {
+    const auto c = static_cast<std::size_t>(kZoneCause[zone]);
+    SCOPED_TRACE(causeName(kZoneCause[zone]));
+    EXPECT_EQ(a.outsideBand[c].region, 24);
+    EXPECT_EQ(a.outsideBand[c].gross, kGrossPerZone[zone]);
+    EXPECT_EQ(a.outsideBand[c].valid, 24 - kMissingPerZone[zone]);
+    EXPECT_EQ(a.resolvable[c].missing(), kMissingPerZone[zone]);
+  }
+  // Single also holds in zone A, where narrow comes first.
+  EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].region, 48);
+  EXPECT_EQ(a.outsideBandWith[static_cast<std::size_t>(Cause::kSingle)].gross, 5);
+  EXPECT_NEAR(grossShare(a, Cause::kGrazing), 4.0 / 28.0, 1e-12);
+  EXPECT_NEAR(missingShare(a, Cause::kDim), 4.0 / 24.0, 1e-12);
+  // 168 pixels, 144 with depth, 28 gross; zones A and B (single) hold 43 valid, 5 gross.
+  EXPECT_NEAR(grossRateWithout(a, std::nullopt), 28.0 / 144.0, 1e-12);
+  EXPECT_NEAR(grossRateWithout(a, Cause::kSingle), 23.0 / 101.0, 1e-12);
+  EXPECT_NEAR(completenessWithout(a, Cause::kNarrow), 122.0 / 144.0, 1e-12);
+  EXPECT_NEAR(grossRateWithout(a, Cause::kOther), 5.0 / 23.0, 1e-12);
+}
+
+// Given runs, then their attribution sums count by count.
+TEST(RealismAttribution, SumsAddTheCounts) {
+  const auto fx = attributionFixture();
+  const Attribution a = attributeRun(fx.frame, 0, fx.merged.view(), fx.region, fx.region);
+  const std::array runs{a, a};
+  const Attribution s = sumAttributions(runs);
+  EXPECT_EQ(s.outsideBand[1].gross, 2 * kGrossPerZone[1]);
+  EXPECT_EQ(s.resolvableWith[0].region, 2 * 24);
+  EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 23.0 / 101.0, 1e-12);
 }
 
 // The fixed-seed CI subset: the first 12 cases as `stripemux eval --only realism` renders them

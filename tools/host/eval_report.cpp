@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
+#include <ostream>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -410,6 +412,77 @@ std::string realismRow(const std::string& head, const std::vector<double>& strip
          fixed(r.lit.rmsDisparityPx, 3) + " |\n";
 }
 
+// Shares per first cause, "n / s / d / g / o" in percent; "–" when there is nothing to share.
+std::string causeShares(const eval::Attribution& a, bool gross) {
+  std::string out;
+  for (int c = 0; c < eval::kCauses; ++c) {
+    const auto cause = static_cast<eval::Cause>(c);
+    const double share = gross ? eval::grossShare(a, cause) : eval::missingShare(a, cause);
+    out += (c == 0 ? "" : " / ") + fixed(100.0 * share, 0);
+  }
+  return out;
+}
+
+std::string attributionRow(const std::string& head, const eval::Attribution& a) {
+  int gross = 0;
+  int missing = 0;
+  for (int c = 0; c < eval::kCauses; ++c) {
+    gross += a.outsideBand[static_cast<std::size_t>(c)].gross;
+    missing += a.resolvable[static_cast<std::size_t>(c)].missing();
+  }
+  return head + " | " + std::to_string(gross) + " | " + (gross > 0 ? causeShares(a, true) : "–") +
+         " | " + std::to_string(missing) + " | " + (missing > 0 ? causeShares(a, false) : "–") +
+         " |\n";
+}
+
+void attributionSection(std::ostream& md, const eval::RealismReport& s) {
+  std::vector<eval::Attribution> all;
+  for (const auto& run : s.runs) {
+    if (!run.refused) {
+      all.push_back(run.attribution);
+    }
+  }
+  const auto sum = eval::sumAttributions(all);
+  md << "### What stops the targets\n\n"
+        "Each gross pixel outside the band and each resolvable pixel without depth goes to the "
+        "first condition it meets, all from the truth and the camera image, never from the "
+        "decoder (`tools/host/eval/include/smx/eval/realism_attribution.hpp`): **narrow** some "
+        "lighting projector's stripes are under "
+     << fixed(eval::kNarrowStripePx, 1)
+     << " px wide in the camera (truth stripe gradient); **single** one projector lights it; "
+        "**dim** the camera image's 3 × 3 box means within "
+     << eval::kDimWindowRadiusPx << " px of it span under " << eval::kDimContrastDn
+     << " DN in every colour channel; **grazing** the truth normal is more than "
+     << fixed(eval::kGrazingDeg, 0)
+     << "° from the camera ray or from every lighting projector's ray; **edge** within "
+     << eval::kNearEdgePx
+     << " px of a depth discontinuity of the truth; **triple** three projectors light it; "
+        "**other** none of these. Shares in % as narrow / single / dim / grazing / edge / "
+        "triple / other.\n\n"
+        "| case | cam | scene | gross outside band, px | shares | missing resolvable, px | "
+        "shares |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& run : s.runs) {
+    if (!run.refused) {
+      md << attributionRow("| " + std::to_string(run.caseIndex) + " | cam" +
+                               std::to_string(run.camera) + " | " + run.summary,
+                           run.attribution);
+    }
+  }
+  md << attributionRow("| **all** | |", sum)
+     << "\nThe aggregate figures with every pixel meeting a condition removed (whatever its "
+        "place in the order):\n\n"
+        "| pixels removed | gross outside band | completeness, resolvable |\n|---|---|---|\n"
+     << "| none | " << pct(eval::grossRateWithout(sum, std::nullopt), 3) << " | "
+     << pct(eval::completenessWithout(sum, std::nullopt)) << " |\n";
+  for (int c = 0; c < eval::kNamedCauses; ++c) {
+    const auto cause = static_cast<eval::Cause>(c);
+    md << "| " << eval::causeName(cause) << " | " << pct(eval::grossRateWithout(sum, cause), 3)
+       << " | " << pct(eval::completenessWithout(sum, cause)) << " |\n";
+  }
+  md << "| all six | " << pct(eval::grossRateWithout(sum, eval::Cause::kOther), 3) << " | "
+     << pct(eval::completenessWithout(sum, eval::Cause::kOther)) << " |\n\n";
+}
+
 void realismSection(Writer& w, const eval::Report& r) {
   const auto& s = r.realism;
   if (s.runs.empty()) {
@@ -493,6 +566,7 @@ void realismSection(Writer& w, const eval::Report& r) {
      << "| RMSE mm | " << fixed(sLit.rmseMm, 2) << " | | | | |\n"
      << "| runs refused by the pipeline | " << refused << " of " << s.runs.size()
      << " | | | | |\n\n";
+  attributionSection(md, s);
 
   md << "### Per run\n\n"
         "Rig: per projector the baseline to this camera, its encoding axis in cam0 and the "

@@ -158,9 +158,11 @@ std::vector<RealismRun> runRealismCase(const RealismCase& c, std::uint64_t seed,
         scoreMerged(f, cam, pipe, litRegion(f, {.patterns = 2, .exactly = true, .smooth = true}));
     r.lit3 =
         scoreMerged(f, cam, pipe, litRegion(f, {.patterns = 3, .exactly = true, .smooth = true}));
-    r.resolvable = scoreMerged(f, cam, pipe, resolvableRegion(f));
-    r.outsideBand = scoreMerged(
-        f, cam, pipe, without(lit, discontinuityBand(f.depth.view(), kDiscontinuityBandPx)));
+    const Mask resolvable = resolvableRegion(f);
+    const Mask outsideBand = without(lit, discontinuityBand(f.depth.view(), kDiscontinuityBandPx));
+    r.resolvable = scoreMerged(f, cam, pipe, resolvable);
+    r.outsideBand = scoreMerged(f, cam, pipe, outsideBand);
+    r.attribution = attributeRun(f, cam, pipe.merged(), outsideBand, resolvable);
     for (int p = 0; p < r.projectors; ++p) {
       r.medianStripePx.push_back(medianStripeWidthPx(f, p));
     }

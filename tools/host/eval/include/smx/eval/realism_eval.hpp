@@ -8,6 +8,7 @@
 #include "smx/algo/image_view.hpp"
 #include "smx/eval/boundary_eval.hpp"
 #include "smx/eval/depth_eval.hpp"
+#include "smx/eval/realism_attribution.hpp"
 #include "smx/eval/realism_case.hpp"
 #include "smx/eval/sim_frame.hpp"
 
@@ -47,6 +48,7 @@ struct RealismRun {
   DepthScore resolvable;
   DepthScore outsideBand;
   std::vector<double> medianStripePx;  // per projector, over the pixels it lights (truth)
+  Attribution attribution;             // what stops the targets (realism_attribution.hpp)
 
   // Kept for the worst cases only (keepWorstImages): the camera image and merged − truth, mm.
   OwnedPlane<algo::Rgb8> image;
