@@ -355,7 +355,7 @@ TEST(Protocol, EncodingAndParsingARangeFrameNeverAllocates) {
 std::vector<std::uint8_t> confidenceOf(const std::vector<std::uint16_t>& depth) {
   std::vector<std::uint8_t> confidence(depth.size());
   for (std::size_t i = 0; i < depth.size(); ++i) {
-    confidence[i] = depth[i] == 0 ? 0 : static_cast<std::uint8_t>(1 + (depth[i] / 8) % 255);
+    confidence[i] = static_cast<std::uint8_t>(depth[i] == 0 ? 0 : 1 + (depth[i] / 8) % 255);
   }
   return confidence;
 }
