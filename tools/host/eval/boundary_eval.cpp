@@ -7,6 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace smx::eval {
 namespace {
@@ -172,6 +173,23 @@ std::optional<StripeGradient> stripeGradient(ImageView<const float> stripe, int 
     return std::nullopt;
   }
   return StripeGradient{.gx = *gx, .gy = *gy, .magnitude = magnitude};
+}
+
+double medianStripeWidthPx(algo::ImageView<const float> stripe, int step) {
+  std::vector<double> widths;
+  for (int y = 0; y < stripe.height(); y += step) {
+    for (int x = 0; x < stripe.width(); x += step) {
+      if (const auto g = stripeGradient(stripe, x, y)) {
+        widths.push_back(1.0 / g->magnitude);
+      }
+    }
+  }
+  if (widths.empty()) {
+    return 0;
+  }
+  auto mid = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
+  std::ranges::nth_element(widths, mid);
+  return *mid;
 }
 
 std::optional<TrueBoundary> trueBoundaryAt(ImageView<const float> stripe, int x, int y) {

@@ -106,21 +106,7 @@ Mask resolvableRegion(const SimFrame& frame) {
 }
 
 double medianStripeWidthPx(const SimFrame& frame, int projector) {
-  std::vector<double> widths;
-  const auto stripe = frame.stripe.at(static_cast<std::size_t>(projector)).view();
-  for (int y = 0; y < stripe.height(); ++y) {
-    for (int x = 0; x < stripe.width(); ++x) {
-      if (const auto g = stripeGradient(stripe, x, y)) {
-        widths.push_back(1.0 / g->magnitude);
-      }
-    }
-  }
-  if (widths.empty()) {
-    return 0;
-  }
-  auto mid = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
-  std::ranges::nth_element(widths, mid);
-  return *mid;
+  return medianStripeWidthPx(frame.stripe.at(static_cast<std::size_t>(projector)).view());
 }
 
 std::vector<RealismRun> runRealismCase(const RealismCase& c, std::uint64_t seed,

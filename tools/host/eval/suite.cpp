@@ -259,21 +259,7 @@ struct Runner {
 
   // The median stripe width in camera pixels over the pixels projector 0 lights.
   static double medianStripeWidth(const SimFrame& f) {
-    std::vector<double> widths;
-    const auto stripe = f.stripe.at(0).view();
-    for (int y = 0; y < f.image.height; y += 2) {
-      for (int x = 0; x < f.image.width; x += 2) {
-        if (const auto g = stripeGradient(stripe, x, y); g && g->magnitude > 0) {
-          widths.push_back(1.0 / g->magnitude);
-        }
-      }
-    }
-    if (widths.empty()) {
-      return 0;
-    }
-    auto mid = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
-    std::ranges::nth_element(widths, mid);
-    return *mid;
+    return medianStripeWidthPx(f.stripe.at(0).view(), 2);
   }
 
   // Generated cases, not named scenes: skipped when the run asks for named scenes only.

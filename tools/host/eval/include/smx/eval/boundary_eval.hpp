@@ -79,6 +79,10 @@ struct StripeGradient {
 [[nodiscard]] std::optional<StripeGradient> stripeGradient(algo::ImageView<const float> stripe,
                                                            int x, int y);
 
+// The median of 1 / |∇s| (stripe width in camera pixels) over every `step`-th pixel of each
+// `step`-th row where the truth has a gradient; 0 where it has none.
+[[nodiscard]] double medianStripeWidthPx(algo::ImageView<const float> stripe, int step = 1);
+
 struct TrueBoundary {
   int level = 0;                          // k, the boundary between stripes k−1 and k
   double deltaPx = 0;                     // δ, from the pixel centre along ĝ
