@@ -1,0 +1,33 @@
+#pragma once
+
+#include <expected>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "smx/algo/rig.hpp"
+#include "smx/calib/camera_calibration.hpp"
+#include "smx/calib/projector_calibration.hpp"
+
+// `stripemux calibrate`: a rig from captures of a printed target (docs/calibration.md).
+namespace smx::calib {
+
+// Reprojection and stripe residuals above these make the verdict "check" rather than "good":
+// a sharp, flat target fits to a small fraction of a pixel.
+inline constexpr double kGoodCameraRmsPx = 0.5;
+inline constexpr double kGoodProjectorRmsPx = 0.5;
+
+struct Calibration {
+  algo::Rig rig;  // the nominal's ids, sizes and patterns; the calibrated geometry
+  std::vector<CameraFit> cameras;
+  std::vector<ProjectorFit> projectors;
+  std::vector<std::string> notes;  // poses or files left out, and why
+  std::string verdict;             // "good", or "check: …" naming what to look at
+};
+
+// Calibrates every camera and projector of `nominal` from the capture set in `dir`. An error
+// names the pose, device or file and what to do; nothing is solved halfway.
+[[nodiscard]] std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
+                                                                const std::filesystem::path& dir);
+
+}  // namespace smx::calib

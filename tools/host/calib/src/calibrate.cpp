@@ -1,0 +1,64 @@
+#include "smx/calib/calibrate.hpp"
+
+#include <cstdio>
+
+#include "smx/calib/capture_set.hpp"
+
+namespace smx::calib {
+namespace {
+
+std::string px(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f px", v);
+  return buf;
+}
+
+}  // namespace
+
+std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
+                                                  const std::filesystem::path& dir) {
+  auto set = openCaptureSet(dir, nominal);
+  if (!set) {
+    return std::unexpected(set.error());
+  }
+  auto cameras = calibrateCameras(*set, nominal);
+  if (!cameras) {
+    return std::unexpected(cameras.error());
+  }
+  Calibration out;
+  out.notes = set->notes;
+  out.notes.insert(out.notes.end(), cameras->notes.begin(), cameras->notes.end());
+  for (const CameraFit& fit : cameras->cameras) {
+    out.rig.cameras.push_back(fit.camera);
+  }
+  for (std::size_t p = 0; p < nominal.projectors.size(); ++p) {
+    auto samples = stripeSamples(*set, *cameras, nominal, p, out.notes);
+    if (!samples) {
+      return std::unexpected(samples.error());
+    }
+    auto fit = fitProjector(nominal.projectors[p], *samples, *set);
+    if (!fit) {
+      return std::unexpected(fit.error());
+    }
+    out.rig.projectors.push_back(fit->projector);
+    out.projectors.push_back(std::move(*fit));
+  }
+  out.cameras = std::move(cameras->cameras);
+  std::string check;
+  for (const CameraFit& fit : out.cameras) {
+    if (fit.rmsPx > kGoodCameraRmsPx) {
+      check += (check.empty() ? "" : "; ") + fit.camera.id + " reprojects to " + px(fit.rmsPx) +
+               " (target not flat, or blurred frames?)";
+    }
+  }
+  for (const ProjectorFit& fit : out.projectors) {
+    if (fit.rmsPx > kGoodProjectorRmsPx) {
+      check += (check.empty() ? "" : "; ") + fit.projector.id + " stripes fit to " + px(fit.rmsPx) +
+               " (projector moved between poses, or the room light changed?)";
+    }
+  }
+  out.verdict = check.empty() ? "good" : "check: " + check;
+  return out;
+}
+
+}  // namespace smx::calib
