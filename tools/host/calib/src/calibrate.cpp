@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "smx/calib/capture_set.hpp"
+#include "smx/calib/joint_refinement.hpp"
 
 namespace smx::calib {
 namespace {
@@ -28,22 +29,32 @@ std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
   Calibration out;
   out.notes = set->notes;
   out.notes.insert(out.notes.end(), cameras->notes.begin(), cameras->notes.end());
-  for (const CameraFit& fit : cameras->cameras) {
-    out.rig.cameras.push_back(fit.camera);
-  }
+  std::vector<std::vector<StripeSample>> samples;
   for (std::size_t p = 0; p < nominal.projectors.size(); ++p) {
-    auto samples = stripeSamples(*set, *cameras, nominal, p, out.notes);
-    if (!samples) {
-      return std::unexpected(samples.error());
+    auto decoded = stripeSamples(*set, *cameras, nominal, p, out.notes);
+    if (!decoded) {
+      return std::unexpected(decoded.error());
     }
-    auto fit = fitProjector(nominal.projectors[p], *samples, *set);
+    auto fit = fitProjector(nominal.projectors[p], *decoded, *set);
     if (!fit) {
       return std::unexpected(fit.error());
     }
-    out.rig.projectors.push_back(fit->projector);
+    samples.push_back(std::move(*decoded));
     out.projectors.push_back(std::move(*fit));
   }
+  auto joint = refineJointly(*set, nominal, *cameras, out.projectors, samples);
+  if (!joint) {
+    return std::unexpected(joint.error());
+  }
+  out.joint = *joint;
+  for (const CameraFit& fit : cameras->cameras) {
+    out.rig.cameras.push_back(fit.camera);
+  }
+  for (const ProjectorFit& fit : out.projectors) {
+    out.rig.projectors.push_back(fit.projector);
+  }
   out.cameras = std::move(cameras->cameras);
+  out.targets = std::move(cameras->targets);
   std::string check;
   for (const CameraFit& fit : out.cameras) {
     if (fit.rmsPx > kGoodCameraRmsPx) {

@@ -83,6 +83,7 @@ struct Intrinsics {
   std::vector<cv::Mat> rvecs;
   std::vector<cv::Mat> tvecs;
   std::vector<double> perViewRms;
+  std::array<double, 9> sd{};
   double rms = 0.0;
 };
 
@@ -108,6 +109,9 @@ Intrinsics solveIntrinsics(const std::vector<View>& views, const Target& target,
       cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-12));
   for (int i = 0; i < perView.rows; ++i) {
     out.perViewRms.push_back(perView.at<double>(i, 0));
+  }
+  for (int i = 0; i < 9 && i < sdIntrinsic.rows; ++i) {
+    out.sd[static_cast<std::size_t>(i)] = sdIntrinsic.at<double>(i, 0);
   }
   return out;
 }
@@ -216,7 +220,8 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
   std::vector<Intrinsics> intrinsics;
   for (std::size_t c = 0; c < nominal.cameras.size(); ++c) {
     const algo::Camera& cam = nominal.cameras[c];
-    CameraFit fit{.camera = cam, .rmsPx = 0.0, .poses = {}, .fixedAtNominal = {}};
+    CameraFit fit;
+    fit.camera = cam;
     std::vector<View>& views = viewsOf[c];
     for (std::size_t p = 0; p < set.poses.size(); ++p) {
       PoseUse use{.pose = set.poses[p].name, .used = false, .rmsPx = 0.0, .note = {}};
@@ -287,7 +292,12 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
       fit.camera.dist[static_cast<std::size_t>(i)] = solved.dist.at<double>(0, i);
     }
     fit.rmsPx = solved.rms;
+    fit.sd = solved.sd;
+    fit.corners.resize(set.poses.size());
     for (std::size_t i = 0; i < views.size(); ++i) {
+      for (const cv::Point2f& q : views[i].corners) {
+        fit.corners[views[i].pose].push_back({q.x, q.y});
+      }
       fit.poses[views[i].pose].used = true;
       fit.poses[views[i].pose].rmsPx = solved.perViewRms[i];
     }

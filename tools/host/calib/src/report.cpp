@@ -1,5 +1,7 @@
 #include "smx/calib/report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -36,8 +38,14 @@ Json reportJson(const Calibration& c) {
       }
       poses.push_back(std::move(p));
     }
+    Json sd;
+    const char* names[] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
+    for (std::size_t i = 0; i < fit.sd.size(); ++i) {
+      sd[names[i]] = rounded(fit.sd[i], i < 4 ? 1e-3 : 1e-6);
+    }
     cameras.push_back({{"id", fit.camera.id},
                        {"rms_px", rounded(fit.rmsPx, 1e-4)},
+                       {"standard_deviation", std::move(sd)},
                        {"fixed_at_nominal", fit.fixedAtNominal},
                        {"poses", std::move(poses)}});
   }
@@ -74,7 +82,8 @@ std::string reportText(const Calibration& c) {
       used += use.used ? 1 : 0;
     }
     s << fit.camera.id << ": reprojection RMS " << fixed(fit.rmsPx, 3) << " px over " << used
-      << " of " << fit.poses.size() << " poses";
+      << " of " << fit.poses.size() << " poses; focal length ±" << fixed(fit.sd[0], 2)
+      << " px, principal point ±" << fixed(std::max(fit.sd[2], fit.sd[3]), 2) << " px";
     for (const PoseUse& use : fit.poses) {
       if (!use.used) {
         s << "\n  " << use.pose << ": " << use.note;

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "smx/algo/camera_pipeline.hpp"
@@ -90,6 +91,22 @@ std::expected<void, std::string> decodeView(const algo::Camera& camera,
 
 }  // namespace
 
+std::optional<Eigen::Vector3d> targetPoint(const algo::Camera& camera, const TargetPose& pose,
+                                           double x, double y) {
+  const auto ray = algo::lens::pixelRay(camera, {x, y});
+  if (!ray) {
+    return std::nullopt;
+  }
+  const Eigen::Vector3d o = toEigen(ray->origin);
+  const Eigen::Vector3d d = toEigen(ray->direction);
+  const Eigen::Vector3d normal = pose.R.col(2);
+  const double facing = normal.dot(d);
+  if (std::abs(facing) < 1e-6) {
+    return std::nullopt;
+  }
+  return o + d * (normal.dot(pose.t - o) / facing);
+}
+
 std::expected<std::vector<StripeSample>, std::string> stripeSamples(
     const CaptureSet& set, const CamerasFit& cameras, const algo::Rig& nominal,
     std::size_t projector, std::vector<std::string>& notes) {
@@ -103,7 +120,6 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
     if (!pose.known) {
       continue;  // the cameras' notes say why
     }
-    const Eigen::Vector3d normal = pose.R.col(2);
     for (std::size_t c = 0; c < cameras.cameras.size(); ++c) {
       const algo::Camera& camera = cameras.cameras[c].camera;
       if (files.lit[projector][c].empty() || files.off[c].empty()) {
@@ -144,25 +160,20 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
           if (s == algo::kNoStripe) {
             continue;
           }
-          const auto ray =
-              algo::lens::pixelRay(camera, {static_cast<double>(x), static_cast<double>(y)});
-          if (!ray) {
+          const auto point =
+              targetPoint(camera, pose, static_cast<double>(x), static_cast<double>(y));
+          if (!point) {
             continue;
           }
-          const Eigen::Vector3d o = toEigen(ray->origin);
-          const Eigen::Vector3d d = toEigen(ray->direction);
-          const double facing = normal.dot(d);
-          if (std::abs(facing) < 1e-6) {
-            continue;
-          }
-          const Eigen::Vector3d point = o + d * (normal.dot(pose.t - o) / facing);
-          const Eigen::Vector3d local = pose.R.transpose() * (point - pose.t);
+          const Eigen::Vector3d local = pose.R.transpose() * (*point - pose.t);
           // On the printed squares: beyond them the sheet's margin is of unknown size.
           if (local.x() < -target.squareM || local.x() > target.cols * target.squareM ||
               local.y() < -target.squareM || local.y() > target.rows * target.squareM) {
             continue;
           }
-          samples.push_back({.point = point,
+          samples.push_back({.x = static_cast<double>(x),
+                             .y = static_cast<double>(y),
+                             .point = *point,
                              .stripe = static_cast<double>(s) / algo::kStripeOne,
                              .pose = p,
                              .camera = c});

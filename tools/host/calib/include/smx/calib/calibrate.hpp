@@ -7,6 +7,7 @@
 
 #include "smx/algo/rig.hpp"
 #include "smx/calib/camera_calibration.hpp"
+#include "smx/calib/joint_refinement.hpp"
 #include "smx/calib/projector_calibration.hpp"
 
 // `stripemux calibrate`: a rig from captures of a printed target (docs/calibration.md).
@@ -21,6 +22,8 @@ struct Calibration {
   algo::Rig rig;  // the nominal's ids, sizes and patterns; the calibrated geometry
   std::vector<CameraFit> cameras;
   std::vector<ProjectorFit> projectors;
+  std::vector<TargetPose> targets;  // per pose of the set (known = placed)
+  JointFigures joint;
   std::vector<std::string> notes;  // poses or files left out, and why
   std::string verdict;             // "good", or "check: …" naming what to look at
 };

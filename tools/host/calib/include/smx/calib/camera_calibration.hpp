@@ -29,8 +29,14 @@ struct PoseUse {
 struct CameraFit {
   algo::Camera camera;
   double rmsPx = 0.0;  // over the corners of the poses used
+  // Standard deviations of fx, fy, cx, cy (px) and k1, k2, p1, p2, k3 as the fit estimates them
+  // from the corners' scatter: how well the data determined each.
+  std::array<double, 9> sd{};
   std::vector<PoseUse> poses;
   std::vector<std::string> fixedAtNominal;  // parameters the data did not determine
+  // Per pose of the set: the target's corners found in this camera, in target order; empty where
+  // the pose is not used.
+  std::vector<std::vector<std::array<double, 2>>> corners;
 };
 
 // Target → world: X = R · x + t.

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <expected>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,8 @@
 namespace smx::calib {
 
 struct StripeSample {
+  double x = 0.0;  // camera pixel
+  double y = 0.0;
   Eigen::Vector3d point;  // world, on the target
   double stripe = 0.0;    // decoded stripe coordinate (algo::stripeCoordinate units)
   std::size_t pose = 0;
@@ -46,7 +49,14 @@ struct ProjectorFit {
   int outliers = 0;
   std::vector<PoseResidual> poses;
   std::vector<std::string> fixedAtNominal;
+  std::vector<StripeSample> inliers;  // the samples the fit kept
 };
+
+// Where camera pixel (x, y) sees the target's plane in `pose`, world; nullopt when the ray
+// misses it.
+[[nodiscard]] std::optional<Eigen::Vector3d> targetPoint(const algo::Camera& camera,
+                                                         const TargetPose& pose, double x,
+                                                         double y);
 
 // The decoded stripe coordinates of projector `projector` of `nominal` over the set's poses and
 // cameras. Poses the target was not placed in, or without that projector's frame, are skipped
@@ -54,6 +64,15 @@ struct ProjectorFit {
 [[nodiscard]] std::expected<std::vector<StripeSample>, std::string> stripeSamples(
     const CaptureSet& set, const CamerasFit& cameras, const algo::Rig& nominal,
     std::size_t projector, std::vector<std::string>& notes);
+
+// The sample's residual across the stripes in projector pixels: the stripe coordinate
+// `projector` casts on the sample's point minus the decoded one.
+[[nodiscard]] double stripeResidualPx(const algo::Projector& projector, const StripeSample& sample);
+
+// Sets fit's residual figures (overall and per pose of `set`) from fit.projector and
+// fit.inliers; `all` are the samples before outliers were removed.
+void measureResiduals(ProjectorFit& fit, const std::vector<StripeSample>& all,
+                      const CaptureSet& set);
 
 // Fits `nominal`'s pose and lens to the samples.
 [[nodiscard]] std::expected<ProjectorFit, std::string> fitProjector(
