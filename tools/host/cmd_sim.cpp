@@ -1,6 +1,9 @@
 // stripemux sim --rig rig.json --scene scene.json|NAME --out DIR [--frames N] [--seed S]
 //               [--lit all|none|ID,ID...] [--no-truth]
-// Renders what each camera of the rig sees, with ground truth (docs/simulator.md, docs/cli.md).
+// stripemux sim --rig rig.json --calibration N --out DIR [--seed S] [--target target.json]
+//               [--realism]
+// Renders what each camera of the rig sees, with ground truth, or calibration captures of a
+// checkerboard (docs/simulator.md, docs/cli.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +22,7 @@
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/renderer.hpp"
+#include "sim_calibration.hpp"
 
 namespace smx::host {
 namespace {
@@ -33,6 +37,9 @@ struct SimOptions {
   std::uint64_t seed = 1;
   std::string lit = "all";
   bool noTruth = false;
+  int calibration = 0;  // poses; 0: render the scene instead
+  fs::path target;      // empty: the default CalibrationTarget
+  bool realism = false;
 };
 
 std::expected<std::vector<bool>, std::string> parseLit(const std::string& spec,
@@ -193,6 +200,107 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
+// Noise seed of one lit state of a pose (0: every projector off, 1 + p: projector p alone), so
+// that the frames of a pose do not share their noise.
+std::uint64_t litSeed(std::uint64_t seed, std::size_t state) {
+  return seed + state * 0x9E3779B97F4A7C15ULL;
+}
+
+// DIR/target.json, DIR/poseNN/<cam>.png and <proj>.<cam>.png, DIR/truth/{rig,poses,scene}.json
+// and DIR/truth/target.png (docs/cli.md).
+int runCalibration(const SimOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux sim: " << message << "\n";
+    return code;
+  };
+  auto rig = config::loadRig(opts.rig);
+  if (!rig) {
+    return fail(kExitBadInput, rig.error().message());
+  }
+  CalibrationTarget target;
+  if (!opts.target.empty()) {
+    auto loaded = loadTarget(opts.target);
+    if (!loaded) {
+      return fail(kExitBadInput, loaded.error());
+    }
+    target = *loaded;
+  }
+  const auto poses = drawTargetPoses(*rig, target, opts.calibration, opts.seed);
+  if (!poses) {
+    return fail(kExitBadInput, poses.error());
+  }
+  // Rendered with one frame per pose; the scene file holds each pose for a while.
+  const sim::Scene scene = calibrationScene(target, *poses, 1, opts.seed, opts.realism);
+  auto renderer = sim::Renderer::create(*rig, scene);
+  if (!renderer) {
+    return fail(kExitBadInput, renderer.error());
+  }
+  auto top = OutputFolder::create(opts.out);
+  auto truth = OutputFolder::create(opts.out / "truth");
+  if (!top || !truth) {
+    return fail(kExitDeviceOrIo, !top ? top.error() : truth.error());
+  }
+  sim::Scene sceneFile = scene;
+  sceneFile.objects.front().poseSequence.holdFrames = kSceneHoldFrames;
+  const TargetSheet sheet = targetSheet(target);
+  Plane<std::uint8_t> sheetImage(sheet.width, sheet.height, 0);
+  std::copy(sheet.grey.begin(), sheet.grey.end(), sheetImage.pixels.begin());
+  for (auto r : {top->writeText("target.json", targetJson(target)),
+                 truth->writeText("rig.json", config::toJson(*rig)),
+                 truth->writeText("poses.json", targetPosesJson(*poses)),
+                 truth->writeText("scene.json", calibrationSceneJson(sceneFile)),
+                 writePngGray8(*truth, "target.png", sheetImage.view)}) {
+    if (!r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<OutputFolder> poseFolders;
+  for (int pose = 0; pose < opts.calibration; ++pose) {
+    auto folder = OutputFolder::create(opts.out / poseDirName(pose));
+    if (!folder) {
+      return fail(kExitDeviceOrIo, folder.error());
+    }
+    for (std::size_t c = 0; c < rig->cameras.size(); ++c) {
+      const auto& camera = rig->cameras[c];
+      for (std::size_t state = 0; state <= rig->projectors.size(); ++state) {
+        std::vector<bool> lit(rig->projectors.size(), false);
+        std::string name = camera.id + ".png";
+        if (state > 0) {
+          lit[state - 1] = true;
+          name = rig->projectors[state - 1].id + "." + name;
+        }
+        const Plane<algo::Rgb8> image(camera.width, camera.height, algo::Rgb8{0, 0, 0});
+        const sim::FrameRequest request{static_cast<int>(c), pose, lit, litSeed(opts.seed, state)};
+        if (auto r = (*renderer)->render(request, image.view, nullptr); !r) {
+          return fail(kExitBadInput, camera.id + ": " + r.error());
+        }
+        if (auto r = writePngRgb8(*folder, name, image.view); !r) {
+          return fail(kExitDeviceOrIo, r.error());
+        }
+      }
+    }
+    poseFolders.push_back(std::move(*folder));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (auto* folder : {&*top, &*truth}) {
+    if (auto r = folder->commit(); !r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+  }
+  for (auto& folder : poseFolders) {
+    if (auto r = folder.commit(); !r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+  }
+  io.out << "wrote " << opts.calibration << " calibration poses of a " << target.cols << "x"
+         << target.rows << " checkerboard to " << opts.out.string() << " ("
+         << rig->cameras.size() * (1 + rig->projectors.size()) << " images per pose, rendered in "
+         << std::lround(seconds) << " s; truth in " << (opts.out / "truth").string() << ")\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
@@ -200,16 +308,36 @@ void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto* cmd =
       app.add_subcommand("sim", "Render what the rig's cameras see of a scene, with ground truth");
   cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
-  cmd->add_option("--scene", opts->scene,
-                  "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene")
-      ->required();
+  auto* scene = cmd->add_option(
+      "--scene", opts->scene, "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene");
+  auto* calibration =
+      cmd->add_option("--calibration", opts->calibration,
+                      "Render calibration captures of a checkerboard in N poses instead of a scene")
+          ->check(CLI::Range(1, 99));
+  scene->excludes(calibration);
+  cmd->add_option("--target", opts->target,
+                  "Calibration target (stripemux-target/1 JSON); default 9x6 corners, 25 mm")
+      ->needs(calibration);
+  cmd->add_flag("--realism", opts->realism,
+                "Calibration captures with realistic optics drawn from their documented ranges")
+      ->needs(calibration);
   cmd->add_option("--out", opts->out, "Output directory")->required();
   cmd->add_option("--frames", opts->frames, "Number of frames (animated scenes move)")
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(1, 100000))
+      ->excludes(calibration);
   cmd->add_option("--seed", opts->seed, "Noise seed");
-  cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list");
-  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images");
-  cmd->callback([opts, &io, &exitCode] { exitCode = runSim(*opts, io); });
+  cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list")
+      ->excludes(calibration);
+  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")
+      ->excludes(calibration);
+  cmd->callback([opts, &io, &exitCode] {
+    if (opts->calibration == 0 && opts->scene.empty()) {
+      io.err << "stripemux sim: give --scene, or --calibration N for calibration captures\n";
+      exitCode = kExitUsage;
+      return;
+    }
+    exitCode = opts->calibration > 0 ? runCalibration(*opts, io) : runSim(*opts, io);
+  });
 }
 
 }  // namespace smx::host
