@@ -16,13 +16,13 @@
 
 #include "commands.hpp"
 #include "output_files.hpp"
+#include "sim_calibration.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/config/scene_json.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/pfm_io.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/renderer.hpp"
-#include "sim_calibration.hpp"
 
 namespace smx::host {
 namespace {
@@ -308,8 +308,9 @@ void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto* cmd =
       app.add_subcommand("sim", "Render what the rig's cameras see of a scene, with ground truth");
   cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
-  auto* scene = cmd->add_option(
-      "--scene", opts->scene, "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene");
+  auto* scene =
+      cmd->add_option("--scene", opts->scene,
+                      "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene");
   auto* calibration =
       cmd->add_option("--calibration", opts->calibration,
                       "Render calibration captures of a checkerboard in N poses instead of a scene")
@@ -328,8 +329,7 @@ void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--seed", opts->seed, "Noise seed");
   cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list")
       ->excludes(calibration);
-  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")
-      ->excludes(calibration);
+  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")->excludes(calibration);
   cmd->callback([opts, &io, &exitCode] {
     if (opts->calibration == 0 && opts->scene.empty()) {
       io.err << "stripemux sim: give --scene, or --calibration N for calibration captures\n";

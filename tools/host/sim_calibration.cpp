@@ -18,8 +18,8 @@
 #include "smx/config/field_reader.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_paths.hpp"
-#include "smx/config/json_text.hpp"
 #include "smx/config/json_reader.hpp"
+#include "smx/config/json_text.hpp"
 
 namespace smx::host {
 namespace {
@@ -61,7 +61,8 @@ std::expected<CalibrationTarget, std::string> parseTargetImpl(std::string_view t
     }
   }
   if (const auto* type = r.find(*doc, "type"); type != nullptr && *type != "checkerboard") {
-    r.fail("type", "must be \"checkerboard\" (the only target type), got " + config::describe(*type));
+    r.fail("type",
+           "must be \"checkerboard\" (the only target type), got " + config::describe(*type));
   }
   if (const auto* corners = r.find(*doc, "inner_corners"); corners != nullptr) {
     if (const auto n = r.numbers<2>(*corners, "inner_corners", "cols, rows", config::Range::kAny)) {
@@ -347,8 +348,7 @@ std::vector<Vec3> targetCorners(const CalibrationTarget& target, const TargetPos
 
 std::expected<std::vector<TargetPose>, std::string> drawTargetPoses(const algo::Rig& rig,
                                                                     const CalibrationTarget& target,
-                                                                    int count,
-                                                                    std::uint64_t seed) {
+                                                                    int count, std::uint64_t seed) {
   if (rig.cameras.empty()) {
     return std::unexpected("the rig has no camera");
   }
@@ -426,8 +426,8 @@ sim::Scene calibrationScene(const CalibrationTarget& target, const std::vector<T
     scene.camera.defocusSigmaPx = rng.uniform(0.0, 0.8);
     scene.camera.responseGamma = rng.uniform(1.0, 2.2);
     scene.camera.vignetting = rng.uniform(0.0, 0.4);
-    const auto mosaic = std::min(static_cast<std::size_t>(rng.uniform(0.0, 5.0)),
-                                 sim::kBayerPatterns.size() - 1);
+    const auto mosaic =
+        std::min(static_cast<std::size_t>(rng.uniform(0.0, 5.0)), sim::kBayerPatterns.size() - 1);
     scene.camera.bayer = sim::kBayerPatterns[mosaic];
   }
   const TargetSheet sheet = targetSheet(target);
