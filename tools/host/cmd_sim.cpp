@@ -8,10 +8,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <expected>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -206,8 +208,64 @@ std::uint64_t litSeed(std::uint64_t seed, std::size_t state) {
   return seed + state * 0x9E3779B97F4A7C15ULL;
 }
 
-// DIR/target.json, DIR/poseNN/<cam>.png and <proj>.<cam>.png, DIR/truth/{rig,poses,scene}.json
-// and DIR/truth/target.png (docs/cli.md).
+// DIR/target.json, and in DIR/truth rig.json, poses.json, scene.json and target.png.
+std::expected<void, std::string> writeCalibrationTruth(OutputFolder& top, OutputFolder& truth,
+                                                       const algo::Rig& rig,
+                                                       const CalibrationTarget& target,
+                                                       const std::vector<TargetPose>& poses,
+                                                       const sim::Scene& scene) {
+  sim::Scene held = scene;
+  held.objects.front().poseSequence.holdFrames = kSceneHoldFrames;
+  const TargetSheet sheet = targetSheet(target);
+  Plane<std::uint8_t> sheetImage(sheet.width, sheet.height, 0);
+  std::copy(sheet.grey.begin(), sheet.grey.end(), sheetImage.pixels.begin());
+  if (auto r = top.writeText("target.json", targetJson(target)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("rig.json", config::toJson(rig)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("poses.json", targetPosesJson(poses)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("scene.json", calibrationSceneJson(held)); !r) {
+    return r;
+  }
+  return writePngGray8(truth, "target.png", sheetImage.view);
+}
+
+// Every camera's images of one pose: projectors off, then each projector alone. Errors carry
+// their exit code.
+std::expected<void, std::pair<int, std::string>> renderCalibrationPose(sim::Renderer& renderer,
+                                                                       const algo::Rig& rig,
+                                                                       int pose, std::uint64_t seed,
+                                                                       OutputFolder& folder) {
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const auto& camera = rig.cameras[c];
+    for (std::size_t state = 0; state <= rig.projectors.size(); ++state) {
+      std::vector<bool> lit(rig.projectors.size(), false);
+      std::string name;
+      if (state > 0) {
+        lit[state - 1] = true;
+        name = rig.projectors[state - 1].id;
+        name += '.';
+      }
+      name += camera.id;
+      name += ".png";
+      const Plane<algo::Rgb8> image(camera.width, camera.height, algo::Rgb8{0, 0, 0});
+      const sim::FrameRequest request{static_cast<int>(c), pose, lit, litSeed(seed, state)};
+      if (auto r = renderer.render(request, image.view, nullptr); !r) {
+        return std::unexpected(std::pair{kExitBadInput, camera.id + ": " + r.error()});
+      }
+      if (auto r = writePngRgb8(folder, name, image.view); !r) {
+        return std::unexpected(std::pair{kExitDeviceOrIo, r.error()});
+      }
+    }
+  }
+  return {};
+}
+
+// The capture layout of docs/cli.md; nothing is left behind when a step fails.
 int runCalibration(const SimOptions& opts, const CliStreams& io) {
   const auto fail = [&](int code, const std::string& message) {
     io.err << "stripemux sim: " << message << "\n";
@@ -229,67 +287,45 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
   if (!poses) {
     return fail(kExitBadInput, poses.error());
   }
-  // Rendered with one frame per pose; the scene file holds each pose for a while.
+  // One frame per pose here; the scene file holds each pose for a while.
   const sim::Scene scene = calibrationScene(target, *poses, 1, opts.seed, opts.realism);
   auto renderer = sim::Renderer::create(*rig, scene);
   if (!renderer) {
     return fail(kExitBadInput, renderer.error());
   }
+  // Declared first, destroyed last: a failed run removes the subfolders before DIR.
   auto top = OutputFolder::create(opts.out);
-  auto truth = OutputFolder::create(opts.out / "truth");
-  if (!top || !truth) {
-    return fail(kExitDeviceOrIo, !top ? top.error() : truth.error());
+  if (!top) {
+    return fail(kExitDeviceOrIo, top.error());
   }
-  sim::Scene sceneFile = scene;
-  sceneFile.objects.front().poseSequence.holdFrames = kSceneHoldFrames;
-  const TargetSheet sheet = targetSheet(target);
-  Plane<std::uint8_t> sheetImage(sheet.width, sheet.height, 0);
-  std::copy(sheet.grey.begin(), sheet.grey.end(), sheetImage.pixels.begin());
-  for (auto r : {top->writeText("target.json", targetJson(target)),
-                 truth->writeText("rig.json", config::toJson(*rig)),
-                 truth->writeText("poses.json", targetPosesJson(*poses)),
-                 truth->writeText("scene.json", calibrationSceneJson(sceneFile)),
-                 writePngGray8(*truth, "target.png", sheetImage.view)}) {
-    if (!r) {
-      return fail(kExitDeviceOrIo, r.error());
-    }
-  }
-  const auto start = std::chrono::steady_clock::now();
-  std::vector<OutputFolder> poseFolders;
+  std::vector<fs::path> dirs = {opts.out / "truth"};
   for (int pose = 0; pose < opts.calibration; ++pose) {
-    auto folder = OutputFolder::create(opts.out / poseDirName(pose));
+    dirs.push_back(opts.out / poseDirName(pose));
+  }
+  std::vector<OutputFolder> folders;  // truth, then one per pose
+  for (const auto& dir : dirs) {
+    auto folder = OutputFolder::create(dir);
     if (!folder) {
       return fail(kExitDeviceOrIo, folder.error());
     }
-    for (std::size_t c = 0; c < rig->cameras.size(); ++c) {
-      const auto& camera = rig->cameras[c];
-      for (std::size_t state = 0; state <= rig->projectors.size(); ++state) {
-        std::vector<bool> lit(rig->projectors.size(), false);
-        std::string name = camera.id + ".png";
-        if (state > 0) {
-          lit[state - 1] = true;
-          name = rig->projectors[state - 1].id + "." + name;
-        }
-        const Plane<algo::Rgb8> image(camera.width, camera.height, algo::Rgb8{0, 0, 0});
-        const sim::FrameRequest request{static_cast<int>(c), pose, lit, litSeed(opts.seed, state)};
-        if (auto r = (*renderer)->render(request, image.view, nullptr); !r) {
-          return fail(kExitBadInput, camera.id + ": " + r.error());
-        }
-        if (auto r = writePngRgb8(*folder, name, image.view); !r) {
-          return fail(kExitDeviceOrIo, r.error());
-        }
-      }
+    folders.push_back(std::move(*folder));
+  }
+  if (auto r = writeCalibrationTruth(*top, folders[0], *rig, target, *poses, scene); !r) {
+    return fail(kExitDeviceOrIo, r.error());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (int pose = 0; pose < opts.calibration; ++pose) {
+    auto& folder = folders[static_cast<std::size_t>(pose) + 1];
+    if (auto r = renderCalibrationPose(**renderer, *rig, pose, opts.seed, folder); !r) {
+      return fail(r.error().first, r.error().second);
     }
-    poseFolders.push_back(std::move(*folder));
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (auto* folder : {&*top, &*truth}) {
-    if (auto r = folder->commit(); !r) {
-      return fail(kExitDeviceOrIo, r.error());
-    }
+  if (auto r = top->commit(); !r) {
+    return fail(kExitDeviceOrIo, r.error());
   }
-  for (auto& folder : poseFolders) {
+  for (auto& folder : folders) {
     if (auto r = folder.commit(); !r) {
       return fail(kExitDeviceOrIo, r.error());
     }
@@ -306,7 +342,9 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
 void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<SimOptions>();
   auto* cmd =
-      app.add_subcommand("sim", "Render what the rig's cameras see of a scene, with ground truth");
+      app.add_subcommand("sim",
+                         "Render what the rig's cameras see of a scene, with ground truth, or "
+                         "calibration captures of a checkerboard");
   cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
   auto* scene =
       cmd->add_option("--scene", opts->scene,

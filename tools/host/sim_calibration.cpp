@@ -55,7 +55,7 @@ std::expected<CalibrationTarget, std::string> parseTargetImpl(std::string_view t
   }
   config::FieldReader r;
   CalibrationTarget target;
-  for (const auto key : {"type", "inner_corners", "square_m"}) {
+  for (const auto* const key : {"type", "inner_corners", "square_m"}) {
     if (!doc->contains(key)) {
       r.fail(key, "required field is missing");
     }
@@ -402,8 +402,9 @@ TargetSheet targetSheet(const CalibrationTarget& target) {
   for (int j = 0; j <= target.rows; ++j) {
     for (int i = 0; i <= target.cols; ++i) {
       if ((i + j) % 2 == 0) {
-        sheet.grey[static_cast<std::size_t>((j + kTargetMarginSquares) * sheet.width + i +
-                                            kTargetMarginSquares)] = kPrintedBlack;
+        const auto row = static_cast<std::size_t>(j + kTargetMarginSquares);
+        const auto col = static_cast<std::size_t>(i + kTargetMarginSquares);
+        sheet.grey[row * static_cast<std::size_t>(sheet.width) + col] = kPrintedBlack;
       }
     }
   }
