@@ -307,6 +307,36 @@ TEST_F(CliSimCalibration, ImagesShowTheTargetWhereTheTruthPutsIt) {
   }
 }
 
+// Given --realism, then the optics of the captures (as truth/scene.json records them) are drawn
+// from the documented ranges; without it they are the defaults, with the default noise.
+TEST_F(CliSimCalibration, RealismDrawsTheOpticsFromTheirRanges) {
+  ASSERT_EQ(capture(dir_ / "plain", 1, 4).code, kExitOk);
+  const auto plain = config::loadScene(dir_ / "plain/truth/scene.json");
+  ASSERT_TRUE(plain.has_value()) << plain.error().message();
+  EXPECT_EQ(plain->camera.responseGamma, 1.0);
+  EXPECT_EQ(plain->camera.vignetting, 0.0);
+  EXPECT_EQ(plain->lighting.projectorBlackLevel, 0.0);
+  EXPECT_EQ(plain->camera.noiseSigma, sim::CameraResponse{}.noiseSigma);
+
+  ASSERT_EQ(capture(dir_ / "real", 1, 4, {"--realism"}).code, kExitOk);
+  const auto real = config::loadScene(dir_ / "real/truth/scene.json");
+  ASSERT_TRUE(real.has_value()) << real.error().message();
+  const auto& c = real->camera;
+  const auto& l = real->lighting;
+  EXPECT_GT(c.responseGamma, 1.0);
+  EXPECT_LE(c.responseGamma, 2.2);
+  EXPECT_LE(c.vignetting, 0.4);
+  EXPECT_LE(c.defocusSigmaPx, 0.8);
+  EXPECT_GE(l.projectorBlackLevel, 0.001);
+  EXPECT_LE(l.projectorBlackLevel, 0.02);
+  EXPECT_GE(l.projectorGamma, 1.8);
+  EXPECT_LE(l.projectorGamma, 2.4);
+  EXPECT_EQ(c.noiseSigma, sim::CameraResponse{}.noiseSigma);
+  // The same poses: the optics have their own random stream.
+  EXPECT_EQ(readText(dir_ / "plain/truth/poses.json"), readText(dir_ / "real/truth/poses.json"));
+  EXPECT_NE(readText(dir_ / "plain/pose00/cam0.png"), readText(dir_ / "real/pose00/cam0.png"));
+}
+
 TEST_F(CliSimCalibration, BadTargetsAreRefusedNamingTheKeyAndNothingIsWritten) {
   struct Case {
     std::string text;
