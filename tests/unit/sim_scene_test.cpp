@@ -554,9 +554,9 @@ TEST(SceneJsonErrors, UnknownKeysAreRejectedWithASuggestion) {
   expectRejected(validSceneWith("\"angular_deg_per_frame\"", "\"angular_deg\""),
                  "objects[1].motion",
                  {"unknown key \"angular_deg\" (did you mean \"angular_deg_per_frame\"?)"});
-  expectRejected(validSceneWith("\"name\": \"ball\",", "\"name\": \"ball\", \"colour\": 1,"),
-                 "objects[2]",
-                 {"unknown key \"colour\"", "allowed keys: name, shape, pose, motion, albedo"});
+  expectRejected(
+      validSceneWith("\"name\": \"ball\",", "\"name\": \"ball\", \"colour\": 1,"), "objects[2]",
+      {"unknown key \"colour\"", "allowed keys: name, shape, pose, motion, pose_sequence, albedo"});
 }
 
 // A key that belongs to another shape type says so.

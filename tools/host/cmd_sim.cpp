@@ -1,18 +1,24 @@
 // stripemux sim --rig rig.json --scene scene.json|NAME --out DIR [--frames N] [--seed S]
 //               [--lit all|none|ID,ID...] [--no-truth]
-// Renders what each camera of the rig sees, with ground truth (docs/simulator.md, docs/cli.md).
+// stripemux sim --rig rig.json --calibration N --out DIR [--seed S] [--target target.json]
+//               [--realism]
+// Renders what each camera of the rig sees, with ground truth, or calibration captures of a
+// checkerboard (docs/simulator.md, docs/cli.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <expected>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
 #include "output_files.hpp"
+#include "sim_calibration.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/config/scene_json.hpp"
 #include "smx/sim/named_scenes.hpp"
@@ -33,6 +39,9 @@ struct SimOptions {
   std::uint64_t seed = 1;
   std::string lit = "all";
   bool noTruth = false;
+  int calibration = 0;  // poses; 0: render the scene instead
+  fs::path target;      // empty: the default CalibrationTarget
+  bool realism = false;
 };
 
 std::expected<std::vector<bool>, std::string> parseLit(const std::string& spec,
@@ -193,23 +202,180 @@ int runSim(const SimOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
+// Noise seed of one lit state of a pose (0: every projector off, 1 + p: projector p alone), so
+// that the frames of a pose do not share their noise.
+std::uint64_t litSeed(std::uint64_t seed, std::size_t state) {
+  return seed + state * 0x9E3779B97F4A7C15ULL;
+}
+
+// DIR/target.json, and in DIR/truth rig.json, poses.json, scene.json and target.png.
+std::expected<void, std::string> writeCalibrationTruth(OutputFolder& top, OutputFolder& truth,
+                                                       const algo::Rig& rig,
+                                                       const CalibrationTarget& target,
+                                                       const std::vector<TargetPose>& poses,
+                                                       const sim::Scene& scene) {
+  sim::Scene held = scene;
+  held.objects.front().poseSequence.holdFrames = kSceneHoldFrames;
+  const TargetSheet sheet = targetSheet(target);
+  Plane<std::uint8_t> sheetImage(sheet.width, sheet.height, 0);
+  std::copy(sheet.grey.begin(), sheet.grey.end(), sheetImage.pixels.begin());
+  if (auto r = top.writeText("target.json", targetJson(target)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("rig.json", config::toJson(rig)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("poses.json", targetPosesJson(poses)); !r) {
+    return r;
+  }
+  if (auto r = truth.writeText("scene.json", calibrationSceneJson(held)); !r) {
+    return r;
+  }
+  return writePngGray8(truth, "target.png", sheetImage.view);
+}
+
+// Every camera's images of one pose: projectors off, then each projector alone. Errors carry
+// their exit code.
+std::expected<void, std::pair<int, std::string>> renderCalibrationPose(sim::Renderer& renderer,
+                                                                       const algo::Rig& rig,
+                                                                       int pose, std::uint64_t seed,
+                                                                       OutputFolder& folder) {
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const auto& camera = rig.cameras[c];
+    for (std::size_t state = 0; state <= rig.projectors.size(); ++state) {
+      std::vector<bool> lit(rig.projectors.size(), false);
+      std::string name;
+      if (state > 0) {
+        lit[state - 1] = true;
+        name = rig.projectors[state - 1].id;
+        name += '.';
+      }
+      name += camera.id;
+      name += ".png";
+      const Plane<algo::Rgb8> image(camera.width, camera.height, algo::Rgb8{0, 0, 0});
+      const sim::FrameRequest request{static_cast<int>(c), pose, lit, litSeed(seed, state)};
+      if (auto r = renderer.render(request, image.view, nullptr); !r) {
+        return std::unexpected(std::pair{kExitBadInput, camera.id + ": " + r.error()});
+      }
+      if (auto r = writePngRgb8(folder, name, image.view); !r) {
+        return std::unexpected(std::pair{kExitDeviceOrIo, r.error()});
+      }
+    }
+  }
+  return {};
+}
+
+// The capture layout of docs/cli.md; nothing is left behind when a step fails.
+int runCalibration(const SimOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux sim: " << message << "\n";
+    return code;
+  };
+  auto rig = config::loadRig(opts.rig);
+  if (!rig) {
+    return fail(kExitBadInput, rig.error().message());
+  }
+  CalibrationTarget target;
+  if (!opts.target.empty()) {
+    auto loaded = loadTarget(opts.target);
+    if (!loaded) {
+      return fail(kExitBadInput, loaded.error());
+    }
+    target = *loaded;
+  }
+  const auto poses = drawTargetPoses(*rig, target, opts.calibration, opts.seed);
+  if (!poses) {
+    return fail(kExitBadInput, poses.error());
+  }
+  // One frame per pose here; the scene file holds each pose for a while.
+  const sim::Scene scene = calibrationScene(target, *poses, 1, opts.seed, opts.realism);
+  auto renderer = sim::Renderer::create(*rig, scene);
+  if (!renderer) {
+    return fail(kExitBadInput, renderer.error());
+  }
+  // Declared first, destroyed last: a failed run removes the subfolders before DIR.
+  auto top = OutputFolder::create(opts.out);
+  if (!top) {
+    return fail(kExitDeviceOrIo, top.error());
+  }
+  std::vector<fs::path> dirs = {opts.out / "truth"};
+  for (int pose = 0; pose < opts.calibration; ++pose) {
+    dirs.push_back(opts.out / poseDirName(pose));
+  }
+  std::vector<OutputFolder> folders;  // truth, then one per pose
+  for (const auto& dir : dirs) {
+    auto folder = OutputFolder::create(dir);
+    if (!folder) {
+      return fail(kExitDeviceOrIo, folder.error());
+    }
+    folders.push_back(std::move(*folder));
+  }
+  if (auto r = writeCalibrationTruth(*top, folders[0], *rig, target, *poses, scene); !r) {
+    return fail(kExitDeviceOrIo, r.error());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (int pose = 0; pose < opts.calibration; ++pose) {
+    auto& folder = folders[static_cast<std::size_t>(pose) + 1];
+    if (auto r = renderCalibrationPose(**renderer, *rig, pose, opts.seed, folder); !r) {
+      return fail(r.error().first, r.error().second);
+    }
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (auto r = top->commit(); !r) {
+    return fail(kExitDeviceOrIo, r.error());
+  }
+  for (auto& folder : folders) {
+    if (auto r = folder.commit(); !r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+  }
+  io.out << "wrote " << opts.calibration << " calibration poses of a " << target.cols << "x"
+         << target.rows << " checkerboard to " << opts.out.string() << " ("
+         << rig->cameras.size() * (1 + rig->projectors.size()) << " images per pose, rendered in "
+         << std::lround(seconds) << " s; truth in " << (opts.out / "truth").string() << ")\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<SimOptions>();
   auto* cmd =
-      app.add_subcommand("sim", "Render what the rig's cameras see of a scene, with ground truth");
+      app.add_subcommand("sim",
+                         "Render what the rig's cameras see of a scene, with ground truth, or "
+                         "calibration captures of a checkerboard");
   cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
-  cmd->add_option("--scene", opts->scene,
-                  "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene")
-      ->required();
+  auto* scene =
+      cmd->add_option("--scene", opts->scene,
+                      "Scene file (stripemux-scene/1 JSON) or the name of a built-in scene");
+  auto* calibration =
+      cmd->add_option("--calibration", opts->calibration,
+                      "Render calibration captures of a checkerboard in N poses instead of a scene")
+          ->check(CLI::Range(1, 99));
+  scene->excludes(calibration);
+  cmd->add_option("--target", opts->target,
+                  "Calibration target (stripemux-target/1 JSON); default 9x6 corners, 25 mm")
+      ->needs(calibration);
+  cmd->add_flag("--realism", opts->realism,
+                "Calibration captures with realistic optics drawn from their documented ranges")
+      ->needs(calibration);
   cmd->add_option("--out", opts->out, "Output directory")->required();
   cmd->add_option("--frames", opts->frames, "Number of frames (animated scenes move)")
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(1, 100000))
+      ->excludes(calibration);
   cmd->add_option("--seed", opts->seed, "Noise seed");
-  cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list");
-  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images");
-  cmd->callback([opts, &io, &exitCode] { exitCode = runSim(*opts, io); });
+  cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list")
+      ->excludes(calibration);
+  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")->excludes(calibration);
+  cmd->callback([opts, &io, &exitCode] {
+    if (opts->calibration == 0 && opts->scene.empty()) {
+      io.err << "stripemux sim: give --scene, or --calibration N for calibration captures\n";
+      exitCode = kExitUsage;
+      return;
+    }
+    exitCode = opts->calibration > 0 ? runCalibration(*opts, io) : runSim(*opts, io);
+  });
 }
 
 }  // namespace smx::host

@@ -64,11 +64,12 @@ constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
 constexpr std::array<std::string_view, 9> kCameraKeys = {
     "crosstalk",  "gain",  "noise_sigma", "defocus_sigma_px", "response_gamma",
     "vignetting", "bayer", "exposure",    "exposure_samples"};
-constexpr std::array<std::string_view, 5> kObjectKeys = {"name", "shape", "pose", "motion",
-                                                         "albedo"};
+constexpr std::array<std::string_view, 6> kObjectKeys = {"name",   "shape",         "pose",
+                                                         "motion", "pose_sequence", "albedo"};
 constexpr std::array<std::string_view, 4> kPoseKeys = {"t", "rotation_deg", "R", "scale"};
 constexpr std::array<std::string_view, 4> kMotionKeys = {"velocity_m_per_frame", "axis",
                                                          "angular_deg_per_frame", "pivot"};
+constexpr std::array<std::string_view, 2> kPoseSequenceKeys = {"hold_frames", "poses"};
 constexpr std::array<std::string_view, 5> kAlbedoKeys = {"rgb", "checker", "texture", "specular",
                                                          "shininess"};
 // The albedo keys of which exactly one is given.
@@ -82,6 +83,11 @@ constexpr std::array<std::string_view, 2> kSphereKeys = {"type", "radius_m"};
 constexpr std::array<std::string_view, 4> kCylinderKeys = {"type", "radius_m", "height_m",
                                                            "capped"};
 constexpr std::array<std::string_view, 2> kMeshKeys = {"type", "path"};
+
+// A pose held for up to a million frames (over 9 hours at 30 Hz); up to a thousand poses, far
+// more than a calibration takes.
+constexpr int kMaxHoldFrames = 1'000'000;
+constexpr std::size_t kMaxSequencePoses = 1000;
 
 // Time samples over one exposure: 16 steps keep a blur of a few pixels smooth.
 constexpr int kMaxExposureSamples = 16;
@@ -345,9 +351,8 @@ void readShape(Reader& r, const Json& obj, const std::string& objectPath, Shape&
   }
 }
 
-void readPose(Reader& r, const Json& obj, const std::string& objectPath, Pose& out) {
-  const std::string path = member(objectPath, "pose");
-  const Json* v = r.find(obj, "pose");
+// One pose object {"t", "R" or "rotation_deg", "scale"} at `path`.
+void readPoseValue(Reader& r, const Json* v, const std::string& path, Pose& out) {
   if (v == nullptr || !r.object(*v, path, "the object's pose", kPoseKeys)) {
     return;
   }
@@ -365,6 +370,45 @@ void readPose(Reader& r, const Json& obj, const std::string& objectPath, Pose& o
     r.mat3(*v, path, "R", "row-major 3x3 rotation, object to world", out.R);
   }
   r.number(*v, path, "scale", Range::kAny, out.scale);
+}
+
+void readPose(Reader& r, const Json& obj, const std::string& objectPath, Pose& out) {
+  readPoseValue(r, r.find(obj, "pose"), member(objectPath, "pose"), out);
+}
+
+// Types and lengths only; the values are checked by checkPoseSequence().
+void readPoseSequence(Reader& r, const Json& obj, const std::string& objectPath,
+                      sim::PoseSequence& out) {
+  const std::string path = member(objectPath, "pose_sequence");
+  const Json* v = r.find(obj, "pose_sequence");
+  if (v == nullptr) {
+    return;
+  }
+  if (obj.contains("pose") || obj.contains("motion")) {
+    r.fail(path, R"(an object with a pose_sequence has no "pose" or "motion": the sequence )"
+                 "gives its poses");
+    return;
+  }
+  if (!r.object(*v, path, R"(a target placed by hand {"hold_frames", "poses"})",
+                kPoseSequenceKeys)) {
+    return;
+  }
+  r.integer(*v, path, "hold_frames", 1, kMaxHoldFrames, "frames each pose is held", out.holdFrames);
+  const std::string at = member(path, "poses");
+  const Json* poses = r.find(*v, "poses");
+  if (poses == nullptr) {
+    r.fail(at, R"(required field is missing; e.g. "poses": [{"t": [0, 0, 0.8]}])");
+    return;
+  }
+  if (!poses->is_array() || poses->empty() || poses->size() > kMaxSequencePoses) {
+    r.fail(at, "must be an array of 1 to " + std::to_string(kMaxSequencePoses) + " poses, got " +
+                   describe(*poses));
+    return;
+  }
+  out.poses.assign(poses->size(), Pose{});
+  for (std::size_t i = 0; i < poses->size() && r.ok(); ++i) {
+    readPoseValue(r, &(*poses)[i], element(at, i), out.poses[i]);
+  }
 }
 
 void readMotion(Reader& r, const Json& obj, const std::string& objectPath, Motion& out) {
@@ -543,6 +587,24 @@ void checkMotion(Reader& r, const Motion& m, const std::string& path) {
   r.checkEach(m.pivot, member(path, "pivot"), Range::kAny);
 }
 
+void checkPoseSequence(Reader& r, const sim::PoseSequence& s, const Motion& m,
+                       const std::string& path) {
+  if (s.poses.empty()) {
+    return;
+  }
+  r.check(s.holdFrames, member(path, "hold_frames"), 1, kMaxHoldFrames, "frames each pose is held");
+  if (r.ok() && s.poses.size() > kMaxSequencePoses) {
+    r.fail(member(path, "poses"), "has " + std::to_string(s.poses.size()) + " poses; at most " +
+                                      std::to_string(kMaxSequencePoses));
+  }
+  for (std::size_t i = 0; i < s.poses.size() && r.ok(); ++i) {
+    checkPose(r, s.poses[i], element(member(path, "poses"), i));
+  }
+  if (r.ok() && (!m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0)) {
+    r.fail(path, "an object with a pose_sequence has no motion");
+  }
+}
+
 void checkAlbedo(Reader& r, const Albedo& a, const std::string& path) {
   if (const auto* c = std::get_if<CheckerTexture>(&a.texture)) {
     const std::string at = member(path, "checker");
@@ -572,6 +634,7 @@ void checkObject(Reader& r, const Object& o, const std::string& path) {
   checkShape(r, o.shape, member(path, "shape"));
   checkPose(r, o.pose, member(path, "pose"));
   checkMotion(r, o.motion, member(path, "motion"));
+  checkPoseSequence(r, o.poseSequence, o.motion, member(path, "pose_sequence"));
   checkAlbedo(r, o.albedo, member(path, "albedo"));
 }
 
@@ -733,6 +796,10 @@ void readObject(Reader& r, const Json& v, std::size_t index, NameRegistry& names
   if (r.ok()) {
     checkMotion(r, object.motion, member(path, "motion"));
     object.motion.axis /= object.motion.axis.stableNorm();
+  }
+  readPoseSequence(r, v, path, object.poseSequence);
+  if (r.ok()) {
+    checkPoseSequence(r, object.poseSequence, object.motion, member(path, "pose_sequence"));
   }
   readAlbedo(r, v, path, object.albedo);
   if (r.ok()) {

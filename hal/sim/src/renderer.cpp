@@ -89,14 +89,30 @@ struct FramePose {
   [[nodiscard]] Vec3 directionToLocal(const Vec3& d) const { return inverse * d; }
 };
 
-bool moves(const Motion& m) {
-  return !m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0;
+// Its pose changes from frame to frame: a motion or a pose sequence.
+bool moves(const Object& o) {
+  const Motion& m = o.motion;
+  return !m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0 ||
+         !o.poseSequence.poses.empty();
+}
+
+// The pose a sequence holds at time f (frames): that of the nearest whole frame, so an exposure
+// across a switch mixes the two poses as a board being put down does.
+FramePose sequencePoseAt(const PoseSequence& sequence, double f) {
+  const double frame = std::max(0.0, std::floor(f + 0.5));
+  const double held = std::floor(frame / sequence.holdFrames);
+  const auto n = static_cast<double>(sequence.poses.size());
+  const Pose& p = sequence.poses[static_cast<std::size_t>(held - n * std::floor(held / n))];
+  return {p.R, p.t, p.scale};
 }
 
 // scene.hpp: rotate by f·angle about `axis` through `pivot`, then translate by f·velocity; f is
 // the time in frames (fractional within an exposure).
 FramePose poseAt(const Object& object, double f) {
-  if (f == 0.0 || !moves(object.motion)) {
+  if (!object.poseSequence.poses.empty()) {
+    return sequencePoseAt(object.poseSequence, f);
+  }
+  if (f == 0.0 || !moves(object)) {
     return {object.pose.R, object.pose.t, object.pose.scale};
   }
   const auto& m = object.motion;
@@ -407,7 +423,7 @@ std::expected<void, std::string> EmbreeRenderer::initGeometry() {
       &embreeError_);
 
   for (const auto& o : scene_.objects) {
-    anyMotion_ = anyMotion_ || moves(o.motion);
+    anyMotion_ = anyMotion_ || moves(o);
   }
   world_.reset(rtcNewScene(device_.get()));
   rtcSetSceneFlags(world_.get(), anyMotion_ ? (RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC)
@@ -477,7 +493,7 @@ void EmbreeRenderer::setTime(double time) {
     return;
   }
   for (auto& state : objects_) {
-    if (!moves(state.object->motion)) {
+    if (!moves(*state.object)) {
       continue;
     }
     state.pose = poseAt(*state.object, time);

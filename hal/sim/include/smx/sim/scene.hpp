@@ -35,6 +35,14 @@ struct Motion {
   Vec3 pivot = Vec3::Zero();
 };
 
+// A target placed by hand: the object holds each pose for holdFrames frames, then jumps to the
+// next, and starts again after the last (frame f shows poses[(f / holdFrames) mod n]). Empty
+// poses: the object keeps `Object::pose`. An object with a sequence has no Motion.
+struct PoseSequence {
+  int holdFrames = 1;
+  std::vector<Pose> poses;
+};
+
 // Albedo textures are evaluated at the object-local surface point (x, y) (a planar mapping along
 // local z; for a plane that is its own surface).
 struct CheckerTexture {
@@ -91,6 +99,7 @@ struct Object {
   Shape shape;
   Pose pose;
   Motion motion;
+  PoseSequence poseSequence;
   Albedo albedo;
 };
 
