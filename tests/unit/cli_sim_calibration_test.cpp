@@ -157,8 +157,8 @@ TEST_F(CliSimCalibration, WritesTheCaptureLayoutAndTruth) {
   const Json target = readJson(out / "target.json");
   EXPECT_EQ(target.at("format"), "stripemux-target/1");
   EXPECT_EQ(target.at("type"), "checkerboard");
-  EXPECT_EQ(target.at("inner_corners"), Json::array({9, 6}));
-  EXPECT_EQ(target.at("square_m"), 0.025);
+  EXPECT_EQ(target.at("inner_corners"), Json::array({11, 8}));
+  EXPECT_EQ(target.at("square_m"), 0.03);
 
   const Json poses = readJson(out / "truth/poses.json");
   EXPECT_EQ(poses.at("format"), "stripemux-calibration-truth/1");
@@ -348,7 +348,7 @@ TEST_F(CliSimCalibration, BadTargetsAreRefusedNamingTheKeyAndNothingIsWritten) {
        "inner_corners: must be an array of 2 numbers"},
       {R"({"format": "stripemux-target/1", "type": "checkerboard", "inner_corners": [9, 2.5],
            "square_m": 0.025})",
-       "inner_corners[1]: must be an integer from 3 to 100"},
+       "inner_corners[1]: must be an integer from 3 to 64"},
       {R"({"format": "stripemux-target/1", "type": "checkerboard", "inner_corners": [9, 6],
            "square_m": -1})",
        "square_m: must be positive"},

@@ -40,7 +40,7 @@ struct SimOptions {
   std::string lit = "all";
   bool noTruth = false;
   int calibration = 0;  // poses; 0: render the scene instead
-  fs::path target;      // empty: the default CalibrationTarget
+  fs::path target;      // empty: the default calib::Target
   bool realism = false;
 };
 
@@ -211,7 +211,7 @@ std::uint64_t litSeed(std::uint64_t seed, std::size_t state) {
 // DIR/target.json, and in DIR/truth rig.json, poses.json, scene.json and target.png.
 std::expected<void, std::string> writeCalibrationTruth(OutputFolder& top, OutputFolder& truth,
                                                        const algo::Rig& rig,
-                                                       const CalibrationTarget& target,
+                                                       const calib::Target& target,
                                                        const std::vector<TargetPose>& poses,
                                                        const sim::Scene& scene) {
   sim::Scene held = scene;
@@ -275,9 +275,9 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
   if (!rig) {
     return fail(kExitBadInput, rig.error().message());
   }
-  CalibrationTarget target;
+  calib::Target target = kDefaultCalibrationTarget;
   if (!opts.target.empty()) {
-    auto loaded = loadTarget(opts.target);
+    auto loaded = calib::loadTarget(opts.target);
     if (!loaded) {
       return fail(kExitBadInput, loaded.error());
     }

@@ -30,68 +30,6 @@ using sim::Vec3;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// --- target.json ---
-
-constexpr std::array<std::string_view, 4> kTargetKeys = {"format", "type", "inner_corners",
-                                                         "square_m"};
-constexpr config::DocumentSpec kTargetDocument = {.name = "target.json",
-                                                  .format = kTargetFormat,
-                                                  .topKeys = kTargetKeys,
-                                                  .maxBytes = std::size_t{64} << 10U,
-                                                  .sizeNote = "",
-                                                  .nestingNeeded = 2,
-                                                  .maxNesting = 8,
-                                                  .otherFormats = {}};
-// From the smallest board OpenCV finds (3 × 3) to a wall chart; squares from 2 mm to 50 cm.
-constexpr int kMinCorners = 3;
-constexpr int kMaxCorners = 100;
-constexpr double kMinSquareM = 0.002;
-constexpr double kMaxSquareM = 0.5;
-
-std::expected<CalibrationTarget, std::string> parseTargetImpl(std::string_view text) {
-  auto doc = config::parseDocument(text, kTargetDocument);
-  if (!doc) {
-    return std::unexpected(config::errorMessage("", doc.error().field, doc.error().problem));
-  }
-  config::FieldReader r;
-  CalibrationTarget target;
-  for (const auto* const key : {"type", "inner_corners", "square_m"}) {
-    if (!doc->contains(key)) {
-      r.fail(key, "required field is missing");
-    }
-  }
-  if (const auto* type = r.find(*doc, "type"); type != nullptr && *type != "checkerboard") {
-    r.fail("type",
-           "must be \"checkerboard\" (the only target type), got " + config::describe(*type));
-  }
-  if (const auto* corners = r.find(*doc, "inner_corners"); corners != nullptr) {
-    if (const auto n = r.numbers<2>(*corners, "inner_corners", "cols, rows", config::Range::kAny)) {
-      for (std::size_t i = 0; i < 2; ++i) {
-        const double v = (*n)[i];
-        if (v != std::floor(v) || v < kMinCorners || v > kMaxCorners) {
-          r.fail(config::element("inner_corners", i),
-                 "must be an integer from " + std::to_string(kMinCorners) + " to " +
-                     std::to_string(kMaxCorners) + ", got " + config::formatNumber(v));
-        }
-      }
-      if (r.ok()) {
-        target.cols = static_cast<int>((*n)[0]);
-        target.rows = static_cast<int>((*n)[1]);
-      }
-    }
-  }
-  r.number(*doc, "", "square_m", config::Range::kPositive, target.squareM);
-  if (r.ok() && (target.squareM < kMinSquareM || target.squareM > kMaxSquareM)) {
-    r.fail("square_m", "must be from " + config::formatNumber(kMinSquareM) + " to " +
-                           config::formatNumber(kMaxSquareM) + " m, got " +
-                           config::formatNumber(target.squareM));
-  }
-  if (const auto& e = r.firstError()) {
-    return std::unexpected(config::errorMessage("", e->field, e->problem));
-  }
-  return target;
-}
-
 // --- geometry ---
 
 // SplitMix64: the same draws on every platform and standard library.
@@ -130,15 +68,15 @@ Vec3 targetPoint(const TargetPose& pose, double x, double y) {
 }
 
 // Centre of the inner-corner grid, which is the centre of the sheet, in target coordinates.
-Vec3 gridCentre(const CalibrationTarget& target) {
+Vec3 gridCentre(const calib::Target& target) {
   return {0.5 * (target.cols - 1) * target.squareM, 0.5 * (target.rows - 1) * target.squareM, 0.0};
 }
 
 // Sheet size, metres: the squares and the white margin round them.
-double sheetWidthM(const CalibrationTarget& target) {
+double sheetWidthM(const calib::Target& target) {
   return (target.cols + 1 + 2 * kTargetMarginSquares) * target.squareM;
 }
-double sheetHeightM(const CalibrationTarget& target) {
+double sheetHeightM(const calib::Target& target) {
   return (target.rows + 1 + 2 * kTargetMarginSquares) * target.squareM;
 }
 
@@ -172,7 +110,7 @@ double workingDistanceM(const algo::Rig& rig) {
 }
 
 // Image area covered by the sheet in `camera`, as a fraction of the image (unclipped).
-std::optional<double> sheetFill(const algo::DeviceModel& camera, const CalibrationTarget& target,
+std::optional<double> sheetFill(const algo::DeviceModel& camera, const calib::Target& target,
                                 const TargetPose& pose) {
   const double s = target.squareM;
   const double x0 = -(1 + kTargetMarginSquares) * s;
@@ -210,7 +148,7 @@ constexpr double kMaxPartialShare = 0.85;
 constexpr int kPartialEvery = 6;
 constexpr int kAttemptsPerPose = 200000;
 
-bool acceptable(const algo::Rig& rig, const CalibrationTarget& target, const TargetPose& pose,
+bool acceptable(const algo::Rig& rig, const calib::Target& target, const TargetPose& pose,
                 bool partial) {
   const auto fill = sheetFill(rig.cameras.front(), target, pose);
   if (!fill || *fill < kMinFill || *fill > kMaxFill) {
@@ -252,7 +190,7 @@ bool acceptable(const algo::Rig& rig, const CalibrationTarget& target, const Tar
 
 // One candidate: the board centre at pixel (u, v) of the first camera and depth z along its axis,
 // parallel to its image plane, then tilted about an axis in the board and turned in its plane.
-std::optional<TargetPose> candidate(const algo::Rig& rig, const CalibrationTarget& target, Rng& rng,
+std::optional<TargetPose> candidate(const algo::Rig& rig, const calib::Target& target, Rng& rng,
                                     double zLo, double zHi, bool partial) {
   const auto& camera = rig.cameras.front();
   const double spread = partial ? 0.6 : 0.2;  // of the image size, either side of its centre
@@ -305,37 +243,16 @@ nlohmann::ordered_json mat3Json(const Mat3& m) {
 
 }  // namespace
 
-std::expected<CalibrationTarget, std::string> parseTarget(std::string_view text) {
-  try {
-    return parseTargetImpl(text);
-  } catch (const std::exception& e) {
-    return std::unexpected(std::string("cannot read the target: ") + e.what());
-  }
-}
-
-std::expected<CalibrationTarget, std::string> loadTarget(const std::filesystem::path& file) {
-  auto text = config::readDocumentFile(file, kTargetDocument);
-  if (!text) {
-    return std::unexpected(
-        config::errorMessage(file.string(), text.error().field, text.error().problem));
-  }
-  auto target = parseTarget(*text);
-  if (!target) {
-    return std::unexpected(file.string() + ": " + target.error());
-  }
-  return target;
-}
-
-std::string targetJson(const CalibrationTarget& target) {
+std::string targetJson(const calib::Target& target) {
   nlohmann::ordered_json doc;
-  doc["format"] = kTargetFormat;
+  doc["format"] = calib::kTargetFormat;
   doc["type"] = "checkerboard";
   doc["inner_corners"] = {target.cols, target.rows};
   doc["square_m"] = target.squareM;
   return doc.dump(2) + "\n";
 }
 
-std::vector<Vec3> targetCorners(const CalibrationTarget& target, const TargetPose& pose) {
+std::vector<Vec3> targetCorners(const calib::Target& target, const TargetPose& pose) {
   std::vector<Vec3> out;
   out.reserve(static_cast<std::size_t>(target.cols) * static_cast<std::size_t>(target.rows));
   for (int row = 0; row < target.rows; ++row) {
@@ -347,7 +264,7 @@ std::vector<Vec3> targetCorners(const CalibrationTarget& target, const TargetPos
 }
 
 std::expected<std::vector<TargetPose>, std::string> drawTargetPoses(const algo::Rig& rig,
-                                                                    const CalibrationTarget& target,
+                                                                    const calib::Target& target,
                                                                     int count, std::uint64_t seed) {
   if (rig.cameras.empty()) {
     return std::unexpected("the rig has no camera");
@@ -391,7 +308,7 @@ std::expected<std::vector<TargetPose>, std::string> drawTargetPoses(const algo::
   return poses;
 }
 
-TargetSheet targetSheet(const CalibrationTarget& target) {
+TargetSheet targetSheet(const calib::Target& target) {
   TargetSheet sheet;
   sheet.width = target.cols + 1 + 2 * kTargetMarginSquares;
   sheet.height = target.rows + 1 + 2 * kTargetMarginSquares;
@@ -411,7 +328,7 @@ TargetSheet targetSheet(const CalibrationTarget& target) {
   return sheet;
 }
 
-sim::Scene calibrationScene(const CalibrationTarget& target, const std::vector<TargetPose>& poses,
+sim::Scene calibrationScene(const calib::Target& target, const std::vector<TargetPose>& poses,
                             int holdFrames, std::uint64_t seed, bool realism) {
   Rng rng(streamSeed(seed, kOpticsStream));
   sim::Scene scene;

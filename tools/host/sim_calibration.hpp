@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "smx/algo/rig.hpp"
+#include "smx/calib/target.hpp"
 #include "smx/sim/scene.hpp"
 
 // Simulated calibration captures (`stripemux sim --calibration N`, docs/simulator.md): a printed
@@ -16,16 +17,11 @@
 // calibration is measured against.
 namespace smx::host {
 
-// target.json, format `stripemux-target/1`: a black-and-white checkerboard with `cols` × `rows`
-// inner corners and squares of `squareM`. Target coordinates: metres, origin at the first inner
-// corner, x along the cols direction, y along rows, z into the board.
-struct CalibrationTarget {
-  int cols = 9;
-  int rows = 6;
-  double squareM = 0.025;
-};
+// The printed target `stripemux sim --calibration` shows unless told otherwise: 11 × 8 inner
+// corners of 30 mm squares, an A3 sheet, large enough at the rigs' working distance to fill a
+// good part of the image.
+inline constexpr calib::Target kDefaultCalibrationTarget{.cols = 11, .rows = 8, .squareM = 0.03};
 
-inline constexpr std::string_view kTargetFormat = "stripemux-target/1";
 inline constexpr std::string_view kCalibrationTruthFormat = "stripemux-calibration-truth/1";
 
 // The printed sheet's white margin round the squares, in squares: findChessboardCorners needs a
@@ -37,11 +33,8 @@ inline constexpr std::uint8_t kPrintedBlack = 13;
 // Frames each pose is held in DIR/truth/scene.json, about a second at the device's frame rate.
 inline constexpr int kSceneHoldFrames = 30;
 
-// Parses target.json; every problem names its key ("inner_corners[1]: must be ...").
-[[nodiscard]] std::expected<CalibrationTarget, std::string> parseTarget(std::string_view text);
-[[nodiscard]] std::expected<CalibrationTarget, std::string> loadTarget(
-    const std::filesystem::path& file);
-[[nodiscard]] std::string targetJson(const CalibrationTarget& target);
+// target.json text for `target`.
+[[nodiscard]] std::string targetJson(const calib::Target& target);
 
 // Target → world (cam0 frame in the example rigs): X = R·x + t.
 struct TargetPose {
@@ -50,7 +43,7 @@ struct TargetPose {
 };
 
 // The world points of the inner corners, row by row (index = row · cols + col).
-[[nodiscard]] std::vector<sim::Vec3> targetCorners(const CalibrationTarget& target,
+[[nodiscard]] std::vector<sim::Vec3> targetCorners(const calib::Target& target,
                                                    const TargetPose& pose);
 
 // `count` poses drawn from `seed`: the board at the rig's working distance, filling 20–70 % of
@@ -59,13 +52,13 @@ struct TargetPose {
 // camera's view, the others wholly in every camera's view. Every corner a camera sees lies inside
 // every projector's image. Fails when the rig leaves no such pose.
 [[nodiscard]] std::expected<std::vector<TargetPose>, std::string> drawTargetPoses(
-    const algo::Rig& rig, const CalibrationTarget& target, int count, std::uint64_t seed);
+    const algo::Rig& rig, const calib::Target& target, int count, std::uint64_t seed);
 
 // The scene of the captures: the target as a textured plane that holds poses[k] for
 // `holdFrames` frames each, room light in [0.35, 0.6] drawn from `seed`, and with `realism` the
 // realistic optics drawn from their documented ranges (docs/simulator.md). The texture's texels
 // are filled; its path is "target.png".
-[[nodiscard]] sim::Scene calibrationScene(const CalibrationTarget& target,
+[[nodiscard]] sim::Scene calibrationScene(const calib::Target& target,
                                           const std::vector<TargetPose>& poses, int holdFrames,
                                           std::uint64_t seed, bool realism);
 
@@ -75,7 +68,7 @@ struct TargetSheet {
   int height = 0;
   std::vector<std::uint8_t> grey;  // row-major
 };
-[[nodiscard]] TargetSheet targetSheet(const CalibrationTarget& target);
+[[nodiscard]] TargetSheet targetSheet(const calib::Target& target);
 
 // scene.json text of calibrationScene()'s scene (readable by config::loadScene() beside
 // target.png).

@@ -1,6 +1,7 @@
 #include "smx/calib/target.hpp"
 
 #include <array>
+#include <cmath>
 #include <exception>
 
 #include "smx/config/field_reader.hpp"
@@ -43,7 +44,8 @@ std::expected<Target, std::string> parseTarget(std::string_view json) {
     config::FieldReader r;
     const auto type = r.text(*doc, "", "type", "\"checkerboard\"");
     if (type && *type != kTypes[0]) {
-      return std::unexpected("type: \"" + *type + "\" is not supported; use \"checkerboard\"");
+      return std::unexpected("type: must be \"checkerboard\" (the only target type), got \"" +
+                             *type + "\"");
     }
     Target target;
     const nlohmann::json* corners = r.find(*doc, "inner_corners");
@@ -56,10 +58,10 @@ std::expected<Target, std::string> parseTarget(std::string_view json) {
       for (std::size_t i = 0; i < 2; ++i) {
         const double v = (*n)[i];
         const std::string at = "inner_corners[" + std::to_string(i) + "]";
-        if (v != static_cast<int>(v)) {
-          r.fail(at, "must be an integer");
+        if (v != std::floor(v) || v < kMinCorners || v > kMaxCorners) {
+          r.fail(at, "must be an integer from " + std::to_string(kMinCorners) + " to " +
+                         std::to_string(kMaxCorners) + ", got " + config::formatNumber(v));
         }
-        r.check(static_cast<int>(v), at, kMinCorners, kMaxCorners, "inner corners");
       }
       target.cols = static_cast<int>((*n)[0]);
       target.rows = static_cast<int>((*n)[1]);
@@ -70,7 +72,8 @@ std::expected<Target, std::string> parseTarget(std::string_view json) {
     }
     r.number(*doc, "", "square_m", config::Range::kPositive, target.squareM);
     if (r.ok() && (target.squareM < kMinSquareM || target.squareM > kMaxSquareM)) {
-      r.fail("square_m", "must be 0.002 to 0.5 (metres), got " + std::to_string(target.squareM));
+      r.fail("square_m",
+             "must be from 0.002 to 0.5 m, got " + config::formatNumber(target.squareM));
     }
     if (r.ok() && (target.cols + target.rows) % 2 == 0) {
       r.fail("inner_corners",
