@@ -21,6 +21,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addEvalCommand(app, io, exitCode);
   addInfoCommand(app, io, exitCode);
   addStreamCommand(app, io, exitCode);
+  addCaptureCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -14,5 +14,6 @@ void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

@@ -1,0 +1,422 @@
+#include "calib_capture.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
+
+#include "output_files.hpp"
+#include "terminal_text.hpp"
+
+namespace smx::host {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Fail = std::unexpected<std::string>;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kMaxInnerCorners = 100;  // per side; real boards have 4 to 30
+constexpr double kFrontalDeg = 15.0;   // a tilt below this counts as facing the camera
+
+struct Target {
+  int cols = 0;
+  int rows = 0;
+  double squareM = 0;
+};
+
+std::expected<Target, std::string> readTarget(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) {
+    return Fail(file.string() + ": cannot read the file");
+  }
+  const Json json = Json::parse(in, nullptr, false);
+  const std::string at = file.string() + ": ";
+  if (json.is_discarded() || !json.is_object()) {
+    return Fail(at + "not a JSON object");
+  }
+  for (const auto& [key, value] : json.items()) {
+    if (key != "format" && key != "type" && key != "inner_corners" && key != "square_m") {
+      return Fail(at + "unknown key \"" + printable(key) +
+                  "\"; allowed keys: format, type, inner_corners, square_m");
+    }
+  }
+  if (!json.contains("format") || json["format"] != "stripemux-target/1") {
+    return Fail(at + "format: must be \"stripemux-target/1\"");
+  }
+  if (!json.contains("type") || json["type"] != "checkerboard") {
+    return Fail(at + "type: must be \"checkerboard\" (the only type the guided capture finds)");
+  }
+  const Json corners = json.value("inner_corners", Json());
+  const auto side = [&](std::size_t i) -> std::optional<int> {
+    if (!corners.is_array() || corners.size() != 2 || !corners[i].is_number_integer()) {
+      return std::nullopt;
+    }
+    const auto v = corners[i].get<std::int64_t>();
+    return v >= 2 && v <= kMaxInnerCorners ? std::optional<int>(static_cast<int>(v)) : std::nullopt;
+  };
+  if (!side(0) || !side(1)) {
+    return Fail(at + "inner_corners: must be [COLS, ROWS], whole numbers 2 to " +
+                std::to_string(kMaxInnerCorners));
+  }
+  const Json square = json.value("square_m", Json());
+  if (!square.is_number() || !(square.get<double>() > 0) || square.get<double>() > 1) {
+    return Fail(at + "square_m: must be a number above 0 and at most 1 (metres)");
+  }
+  return Target{*side(0), *side(1), square.get<double>()};
+}
+
+// DIR/target.json when it exists (given options must agree), else the options (written there).
+std::expected<Target, std::string> resolveTarget(const fs::path& dir,
+                                                 const CaptureGuideOptions& options) {
+  const fs::path file = dir / "target.json";
+  if (fs::exists(file)) {
+    auto target = readTarget(file);
+    if (!target) {
+      return target;
+    }
+    const bool disagrees = (options.cols != 0 && options.cols != target->cols) ||
+                           (options.rows != 0 && options.rows != target->rows) ||
+                           (options.squareM != 0 && options.squareM != target->squareM);
+    if (disagrees) {
+      return Fail(file.string() + " describes another target than the options; remove one");
+    }
+    return target;
+  }
+  if (options.cols < 2 || options.rows < 2 || options.cols > kMaxInnerCorners ||
+      options.rows > kMaxInnerCorners || !(options.squareM > 0)) {
+    return Fail(
+        "no target: give its inner corners and square (--target COLSxROWS --square M) "
+        "or write " +
+        file.string());
+  }
+  auto out = OutputFolder::create(dir);
+  if (!out) {
+    return Fail(out.error());
+  }
+  Json json;
+  json["format"] = "stripemux-target/1";
+  json["type"] = "checkerboard";
+  json["inner_corners"] = {options.cols, options.rows};
+  json["square_m"] = options.squareM;
+  if (auto ok = out->writeText("target.json", json.dump(2) + "\n"); !ok) {
+    return Fail(ok.error());
+  }
+  if (auto ok = out->commit(); !ok) {
+    return Fail(ok.error());
+  }
+  return Target{options.cols, options.rows, options.squareM};
+}
+
+using Corners = std::vector<cv::Point2f>;
+
+// The board's inner corners to a tenth of a pixel, or empty.
+Corners findCorners(const std::vector<algo::Rgb8>& image, int width, int height,
+                    const Target& target) {
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-const-cast): OpenCV reads it only
+  const cv::Mat rgb(height, width, CV_8UC3, const_cast<algo::Rgb8*>(image.data()));
+  cv::Mat grey;
+  cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+  Corners corners;
+  const cv::Size size(target.cols, target.rows);
+  if (!cv::findChessboardCorners(
+          grey, size, corners,
+          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
+    return {};
+  }
+  cv::cornerSubPix(grey, corners, cv::Size(5, 5), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.01));
+  return corners;
+}
+
+// The largest corner displacement between two detections, either corner order (a symmetric
+// board may be found starting from the opposite corner).
+double largestMove(const Corners& a, const Corners& b) {
+  if (a.size() != b.size() || a.empty()) {
+    return std::numeric_limits<double>::infinity();
+  }
+  double same = 0;
+  double reversed = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    same = std::max(same, static_cast<double>(cv::norm(a[i] - b[i])));
+    reversed = std::max(reversed, static_cast<double>(cv::norm(a[i] - b[b.size() - 1 - i])));
+  }
+  return std::min(same, reversed);
+}
+
+struct BoardView {
+  cv::Vec3d normal;  // unit, in the camera frame
+  cv::Point2d centre;
+  double tiltDeg = 0;
+};
+
+// The board's pose from its corners with the rig's (nominal) intrinsics of the camera.
+BoardView boardView(const Corners& corners, const Target& target, const algo::Camera& camera) {
+  std::vector<cv::Point3f> object;
+  for (int r = 0; r < target.rows; ++r) {
+    for (int c = 0; c < target.cols; ++c) {
+      object.emplace_back(static_cast<float>(c * target.squareM),
+                          static_cast<float>(r * target.squareM), 0.0F);
+    }
+  }
+  const cv::Matx33d k(camera.K.data());
+  const cv::Mat dist(1, 5, CV_64F, const_cast<double*>(camera.dist.data()));  // NOLINT: read only
+  cv::Vec3d rvec;
+  cv::Vec3d tvec;
+  cv::solvePnP(object, corners, k, dist, rvec, tvec);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  BoardView view;
+  view.normal = cv::Vec3d(rotation(0, 2), rotation(1, 2), rotation(2, 2));
+  for (const auto& p : corners) {
+    view.centre += cv::Point2d(p.x, p.y);
+  }
+  view.centre *= 1.0 / static_cast<double>(corners.size());
+  view.tiltDeg = std::acos(std::min(1.0, std::abs(view.normal[2]))) * 180.0 / std::numbers::pi;
+  return view;
+}
+
+double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.dot(b)))) * 180.0 / std::numbers::pi;
+}
+
+// Which way a tilted board turns, seen from the camera.
+const char* tiltDirection(const BoardView& view) {
+  if (view.tiltDeg < kFrontalDeg) {
+    return "frontal";
+  }
+  const double x = view.normal[0] * (view.normal[2] < 0 ? -1 : 1);
+  const double y = view.normal[1] * (view.normal[2] < 0 ? -1 : 1);
+  if (std::abs(x) >= std::abs(y)) {
+    return x > 0 ? "right" : "left";
+  }
+  return y > 0 ? "down" : "up";
+}
+
+class Coverage {
+ public:
+  Coverage(const CaptureGuideOptions& options, int width, int height)
+      : cols_(std::max(1, options.gridCols)),
+        rows_(std::max(1, options.gridRows)),
+        width_(width),
+        height_(height),
+        hit_(static_cast<std::size_t>(cols_ * rows_), false) {}
+
+  void add(const Corners& corners, const BoardView& view) {
+    for (const auto& p : corners) {
+      const int cx =
+          std::clamp(static_cast<int>(p.x * static_cast<float>(cols_) / static_cast<float>(width_)),
+                     0, cols_ - 1);
+      const int cy = std::clamp(
+          static_cast<int>(p.y * static_cast<float>(rows_) / static_cast<float>(height_)), 0,
+          rows_ - 1);
+      hit_[static_cast<std::size_t>(cy * cols_ + cx)] = true;
+    }
+    ++tilts_[tiltDirection(view)];
+  }
+  [[nodiscard]] int hit() const { return static_cast<int>(std::ranges::count(hit_, true)); }
+  [[nodiscard]] int cells() const { return cols_ * rows_; }
+
+  void print(std::ostream& out, const std::string& cameraId) const {
+    out << "  image coverage (" << cameraId << "): " << hit() << " of " << cells()
+        << " cells hold corners\n";
+    for (int y = 0; y < rows_; ++y) {
+      out << "    ";
+      for (int x = 0; x < cols_; ++x) {
+        out << (hit_[static_cast<std::size_t>(y * cols_ + x)] ? '#' : '.');
+      }
+      out << "\n";
+    }
+    out << "  tilts so far:";
+    for (const char* direction : {"frontal", "left", "right", "up", "down"}) {
+      const auto found = tilts_.find(direction);
+      out << " " << direction << " " << (found == tilts_.end() ? 0 : found->second);
+    }
+    out << " (frontal: under " << kFrontalDeg << " degrees)\n";
+  }
+
+ private:
+  int cols_;
+  int rows_;
+  int width_;
+  int height_;
+  std::vector<bool> hit_;
+  std::map<std::string, int> tilts_;
+};
+
+std::string poseName(std::size_t index) {
+  std::string number = std::to_string(index);
+  return "pose" + std::string(number.size() < 2 ? 2 - number.size() : 0, '0') + number;
+}
+
+std::string oneDecimal(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v;
+  return s.str();
+}
+
+struct Accepted {
+  std::string name;
+  BoardView view;
+};
+
+// Why the board in `view` is too like an accepted pose, or nothing.
+std::optional<std::string> tooSimilar(const BoardView& view, const std::vector<Accepted>& accepted,
+                                      const CaptureGuideOptions& options, double diagonalPx) {
+  const double centreLimit = options.similarCentre * diagonalPx;
+  for (const auto& earlier : accepted) {
+    const double angle = angleDeg(view.normal, earlier.view.normal);
+    const double shift = cv::norm(view.centre - earlier.view.centre);
+    if (angle < options.similarDeg && shift < centreLimit) {
+      return "too similar to " + earlier.name + ": board normal within " + oneDecimal(angle) +
+             " deg (limit " + oneDecimal(options.similarDeg) + ") and centre within " +
+             oneDecimal(shift) + " px (limit " + oneDecimal(centreLimit) +
+             "); move or tilt the board";
+    }
+  }
+  return std::nullopt;
+}
+
+// Captures the pose's projector frames and writes every image of it.
+std::expected<void, std::string> writePose(DeviceClient& device, const algo::Rig& rig,
+                                           const RawCapture& off,
+                                           const CaptureGuideOptions& options,
+                                           const fs::path& poseDir) {
+  auto out = OutputFolder::create(poseDir);
+  if (!out) {
+    return Fail(out.error());
+  }
+  const auto write = [&](const RawCapture& capture,
+                         const std::string& prefix) -> std::expected<void, std::string> {
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      const auto image =
+          *algo::ConstRgbView::packed(capture.images[c], capture.width, capture.height);
+      if (auto ok = writePngRgb8(*out, prefix + rig.cameras[c].id + ".png", image); !ok) {
+        return ok;
+      }
+    }
+    return {};
+  };
+  if (auto ok = write(off, ""); !ok) {
+    return ok;
+  }
+  for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
+    const auto lit = device.captureRaw(1U << p, options.captureTimeout);
+    if (!lit) {
+      return Fail(rig.projectors[p].id + " on: " + lit.error());
+    }
+    if (auto ok = write(*lit, rig.projectors[p].id + "."); !ok) {
+      return ok;
+    }
+  }
+  return out->commit();
+}
+
+}  // namespace
+
+std::expected<CaptureSummary, std::string> captureCalibrationSet(DeviceClient& device,
+                                                                 const algo::Rig& rig,
+                                                                 const CaptureGuideOptions& options,
+                                                                 const fs::path& dir,
+                                                                 const CliStreams& io) {
+  if (rig.cameras.empty()) {
+    return Fail("the rig has no camera");
+  }
+  if (options.poses < 1) {
+    return Fail("at least one pose is needed");
+  }
+  const auto target = resolveTarget(dir, options);
+  if (!target) {
+    return Fail(target.error());
+  }
+  const algo::Camera& guide = rig.cameras.front();
+  const double diagonal = std::hypot(guide.width, guide.height);
+  io.out << "target: checkerboard of " << target->cols << "x" << target->rows << " inner corners, "
+         << target->squareM * 1000 << " mm squares; hold it still in view "
+         << "of " << guide.id << " for each pose\n";
+
+  CaptureSummary summary;
+  Coverage coverage(options, guide.width, guide.height);
+  std::vector<Accepted> accepted;
+  for (int p = 0; p < options.poses; ++p) {
+    const std::string name = poseName(static_cast<std::size_t>(p));
+    const auto deadline = Clock::now() + options.poseTimeout;
+    Corners previous;
+    std::string said;
+    const auto say = [&](const std::string& text) {
+      if (text != said) {
+        io.out << name << ": " << text << "\n" << std::flush;
+        said = text;
+      }
+    };
+    while (true) {
+      if (Clock::now() > deadline) {
+        return Fail(name + ": " + (said.empty() ? "nothing captured" : said) + " for " +
+                    std::to_string(options.poseTimeout.count() / 1000) +
+                    " s; show the whole board to " + guide.id + " and hold it still");
+      }
+      auto off = device.captureRaw(0, options.captureTimeout);
+      if (!off) {
+        return Fail(name + ": " + off.error());
+      }
+      const Corners corners = findCorners(off->images.front(), off->width, off->height, *target);
+      if (corners.empty()) {
+        say("the target is not found in " + guide.id);
+        previous.clear();
+        continue;
+      }
+      const double move = largestMove(corners, previous);
+      previous = corners;
+      if (!(move < options.stillPx)) {
+        say("target found in " + guide.id + "; waiting for it to hold still");
+        continue;
+      }
+      const BoardView view = boardView(corners, *target, guide);
+      if (auto similar = tooSimilar(view, accepted, options, diagonal)) {
+        say(*similar);
+        continue;
+      }
+      PoseSummary pose{.name = name,
+                       .cornersPerCamera = {static_cast<int>(corners.size())},
+                       .tiltDeg = view.tiltDeg,
+                       .centreX = view.centre.x,
+                       .centreY = view.centre.y};
+      for (std::size_t c = 1; c < rig.cameras.size(); ++c) {
+        pose.cornersPerCamera.push_back(
+            static_cast<int>(findCorners(off->images[c], off->width, off->height, *target).size()));
+      }
+      if (auto written = writePose(device, rig, *off, options, dir / name); !written) {
+        return Fail(name + ": " + written.error());
+      }
+      accepted.push_back({name, view});
+      coverage.add(corners, view);
+      io.out << name << ": captured;";
+      for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+        io.out << " " << pose.cornersPerCamera[c] << " of " << target->cols * target->rows
+               << " corners in " << rig.cameras[c].id << (c + 1 < rig.cameras.size() ? "," : "");
+      }
+      io.out << "; tilt " << oneDecimal(view.tiltDeg) << " deg (" << tiltDirection(view) << ")\n";
+      coverage.print(io.out, guide.id);
+      io.out << std::flush;
+      summary.poses.push_back(std::move(pose));
+      break;
+    }
+  }
+  summary.cellsHit = coverage.hit();
+  summary.cells = coverage.cells();
+  io.out << "wrote " << summary.poses.size() << " poses to " << dir.string() << "\n";
+  return summary;
+}
+
+}  // namespace smx::host
