@@ -362,9 +362,9 @@ std::expected<CaptureSummary, std::string> captureCalibrationSet(DeviceClient& d
     };
     while (true) {
       if (Clock::now() > deadline) {
-        return Fail(name + ": " + (said.empty() ? "nothing captured" : said) + " for " +
-                    std::to_string(options.poseTimeout.count() / 1000) +
-                    " s; show the whole board to " + guide.id + " and hold it still");
+        return Fail(name + ": no pose accepted in " +
+                    oneDecimal(static_cast<double>(options.poseTimeout.count()) / 1000) +
+                    " s: " + (said.empty() ? "no frame arrived" : said));
       }
       auto off = device.captureRaw(0, options.captureTimeout);
       if (!off) {

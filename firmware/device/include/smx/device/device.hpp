@@ -80,6 +80,8 @@ class Device {
   // connection only, the rest since start-up (docs/protocol.md, message 7).
   [[nodiscard]] protocol::Statistics statisticsForHost() const;
   [[nodiscard]] bool streaming() const { return streaming_; }
+  // A host's capture-raw waits for the capture loop.
+  [[nodiscard]] bool rawCaptureRequested() const { return rawState_ == RawState::kRequested; }
   [[nodiscard]] std::size_t arenaBytes() const;
   [[nodiscard]] const hal::Hal& hal() const { return hal_; }
 
