@@ -138,6 +138,11 @@ int runCapture(const CaptureOptions& opts, const CliStreams& io) {
     io.err << "stripemux capture: " << printable(message) << "\n";
     return code;
   };
+  // What can be checked without the device is, before connecting.
+  const auto guide = guideOptions(opts);
+  if (!guide) {
+    return fail(kExitUsage, guide.error());
+  }
   auto client = DeviceClient::connect(opts.device, kConnectTimeout);
   if (!client) {
     return fail(kExitDeviceOrIo, client.error());
@@ -145,10 +150,6 @@ int runCapture(const CaptureOptions& opts, const CliStreams& io) {
   const algo::Rig& rig = client->info().rig;
   const auto timeout = std::chrono::milliseconds(static_cast<long>(opts.timeoutS * 1000));
   if (opts.guided) {
-    const auto guide = guideOptions(opts);
-    if (!guide) {
-      return fail(kExitUsage, guide.error());
-    }
     const auto summary = captureCalibrationSet(*client, rig, *guide, opts.out, io);
     if (!summary) {
       return fail(kExitDeviceOrIo, summary.error());
