@@ -2,12 +2,18 @@
 // reading of raw-frame bands, which come from an unauthenticated device.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "calib_capture.hpp"
 #include "cli.hpp"
 #include "cli_harness.hpp"
+#include "device_client.hpp"
 #include "fake_device.hpp"
 #include "raw_frames.hpp"
 #include "smx/protocol/messages.hpp"
@@ -49,6 +55,46 @@ TEST_F(CliCapture, GuidedTargetMustBeColsByRows) {
   const auto both = test::runCli({"capture", "--device", "127.0.0.1:1", "--projectors", "none",
                                   "--sets", "none", "--out", (dir_ / "out").string()});
   EXPECT_EQ(both.code, kExitUsage) << both.err;
+}
+
+// Given a capture folder whose target.json lies in one field, the guided capture refuses it
+// naming the file and the key, before it asks the device for anything.
+TEST_F(CliCapture, AHostileTargetFileIsRefusedNamingTheKey) {
+  test::FakeDevice device(
+      {.board = "fake",
+       .firmwareVersion = "1.0",
+       .rigJson = test::textWith(smx::test::sourceDir() / "boards/sim/rig_2proj_1cam.json", "", ""),
+       .width = 640,
+       .height = 480});
+  auto client = DeviceClient::connect(device.address(), std::chrono::milliseconds(3000));
+  ASSERT_TRUE(client.has_value()) << client.error();
+  const std::string good =
+      R"({"format": "stripemux-target/1", "type": "checkerboard", "inner_corners": [9, 6], )"
+      R"("square_m": 0.025})";
+  for (const auto& [from, to, key] :
+       {std::tuple<std::string, std::string, std::string>{"[9, 6]", "[1, 6]", "inner_corners:"},
+        {"[9, 6]", "[9.5, 6]", "inner_corners:"},
+        {"[9, 6]", "[9, 6, 2]", "inner_corners:"},
+        {"[9, 6]", "[9, 100000]", "inner_corners:"},
+        {"0.025", "-0.025", "square_m:"},
+        {"0.025", "\"1\"", "square_m:"},
+        {"/1", "/2", "format:"},
+        {"checkerboard", "charuco", "type:"},
+        {"\"type\"", "\"typo\"", "unknown key \"typo\""},
+        {"{", "[", "not a JSON object"}}) {
+    std::string text = good;
+    text.replace(text.find(from), from.size(), to);
+    const fs::path dir = dir_ / "captures";
+    fs::create_directories(dir);
+    std::ofstream(dir / "target.json") << text;
+    std::ostringstream out;
+    std::ostringstream err;
+    const auto result =
+        captureCalibrationSet(*client, client->info().rig, CaptureGuideOptions{}, dir, {out, err});
+    ASSERT_FALSE(result.has_value()) << text;
+    EXPECT_NE(result.error().find("target.json: " + key), std::string::npos) << text << "\n"
+                                                                             << result.error();
+  }
 }
 
 std::vector<std::byte> band(const protocol::RawFrameHeader& header, int width, int height) {

@@ -64,7 +64,9 @@ std::expected<Target, std::string> readTarget(const fs::path& file) {
     const auto v = corners[i].get<std::int64_t>();
     return v >= 2 && v <= kMaxInnerCorners ? std::optional<int>(static_cast<int>(v)) : std::nullopt;
   };
-  if (!side(0) || !side(1)) {
+  const std::optional<int> cols = side(0);
+  const std::optional<int> rows = side(1);
+  if (!cols || !rows) {
     return Fail(at + "inner_corners: must be [COLS, ROWS], whole numbers 2 to " +
                 std::to_string(kMaxInnerCorners));
   }
@@ -72,7 +74,7 @@ std::expected<Target, std::string> readTarget(const fs::path& file) {
   if (!square.is_number() || !(square.get<double>() > 0) || square.get<double>() > 1) {
     return Fail(at + "square_m: must be a number above 0 and at most 1 (metres)");
   }
-  return Target{*side(0), *side(1), square.get<double>()};
+  return Target{*cols, *rows, square.get<double>()};
 }
 
 // DIR/target.json when it exists (given options must agree), else the options (written there).
@@ -209,7 +211,7 @@ class Coverage {
         rows_(std::max(1, options.gridRows)),
         width_(width),
         height_(height),
-        hit_(static_cast<std::size_t>(cols_ * rows_), false) {}
+        hit_(static_cast<std::size_t>(cols_) * static_cast<std::size_t>(rows_), false) {}
 
   void add(const Corners& corners, const BoardView& view) {
     for (const auto& p : corners) {
@@ -219,7 +221,7 @@ class Coverage {
       const int cy = std::clamp(
           static_cast<int>(p.y * static_cast<float>(rows_) / static_cast<float>(height_)), 0,
           rows_ - 1);
-      hit_[static_cast<std::size_t>(cy * cols_ + cx)] = true;
+      hit_[cell(cx, cy)] = true;
     }
     ++tilts_[tiltDirection(view)];
   }
@@ -232,7 +234,7 @@ class Coverage {
     for (int y = 0; y < rows_; ++y) {
       out << "    ";
       for (int x = 0; x < cols_; ++x) {
-        out << (hit_[static_cast<std::size_t>(y * cols_ + x)] ? '#' : '.');
+        out << (hit_[cell(x, y)] ? '#' : '.');
       }
       out << "\n";
     }
@@ -245,6 +247,11 @@ class Coverage {
   }
 
  private:
+  [[nodiscard]] std::size_t cell(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) +
+           static_cast<std::size_t>(x);
+  }
+
   int cols_;
   int rows_;
   int width_;
@@ -254,7 +261,7 @@ class Coverage {
 };
 
 std::string poseName(std::size_t index) {
-  std::string number = std::to_string(index);
+  const std::string number = std::to_string(index);
   return "pose" + std::string(number.size() < 2 ? 2 - number.size() : 0, '0') + number;
 }
 

@@ -254,10 +254,11 @@ std::expected<RawCapture, std::string> DeviceClient::captureRaw(std::uint32_t pr
     if (!message) {
       return Fail(message.error());
     }
-    if (!message->has_value()) {
+    const auto& got = *message;
+    if (!got.has_value()) {
       return silent();
     }
-    const auto& [type, payload] = **message;
+    const auto& [type, payload] = *got;
     if (type == MessageType::kError) {
       const auto error = protocol::decodeError(payload);
       if (error && std::string_view(error->text).find("does not know") != std::string_view::npos) {
