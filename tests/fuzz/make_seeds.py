@@ -189,6 +189,14 @@ def range_seeds():
     write("protocol", "sealed_hello_frames.bin", b"\x87" + frames)
     write("protocol", "sealed_frame_claims_65535.bin",
           b"\x90" + record(5, range_frame(0, 1, 65535, 65535, b"\x00")))
+    # capture-raw, then the bands of a 5×3 raw frame (rows 0–1 and 2), as docs/protocol.md says.
+    def raw_band(first_row, rows):
+        pixels = bytes((7 * k) & 0xFF for k in range(3 * width * rows))
+        return struct.pack("<BIHHHHQq", 0, 1, width, height, first_row, rows, 3, 1000) + pixels
+    write("protocol", "sealed_raw_capture.bin",
+          b"\x87" + record(1, hello) + record(10, struct.pack("<I", 1)) +
+          record(11, raw_band(0, 2)) + record(11, raw_band(2, 1)))
+    write("protocol", "sealed_raw_band_past_height.bin", b"\x90" + record(11, raw_band(2, 2)[:-15]))
 
 
 def main():
