@@ -177,6 +177,15 @@ def range_seeds():
     write("range_frame", "confidence_raw_5x3.bin", announce9 + raw9)
     write("range_frame", "confidence_rvl_5x3.bin", announce9 + rvl9)
     write("range_frame", "near_confidence_short_5x3.bin", announce9 + raw9[:-1])
+    # Raw-frame bands (bit 6 of the announcement's first byte; bit 5: projector mask 1), two
+    # records of [length u16, band] that complete one 5×3 camera.
+    def band(first_row, rows):
+        pixels = bytes((7 * k) & 0xFF for k in range(3 * width * rows))
+        payload = struct.pack("<BIHHHHQq", 0, 1, width, height, first_row, rows, 3, 1000) + pixels
+        return struct.pack("<H", len(payload)) + payload
+    announce_raw = struct.pack("<BHH", 0x60, width - 1, height - 1)
+    write("range_frame", "raw_bands_5x3.bin", announce_raw + band(0, 2) + band(2, 1))
+    write("range_frame", "near_raw_row_twice_5x3.bin", announce_raw + band(0, 2) + band(1, 2))
 
     # The protocol target: a first byte with bit 7 set asks it to seal [type, length u16,
     # payload] records into messages with correct headers.
