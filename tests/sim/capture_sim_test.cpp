@@ -263,6 +263,27 @@ TEST(CaptureSim, TheDeviceRefusesWhatItCannotDoWithAnError) {
   EXPECT_FALSE(running.device->rawCaptureRequested());
 }
 
+// Given a camera that times out during a raw capture, the host is told which camera and why,
+// and the next raw capture works.
+TEST(CaptureSim, ACameraFailingDuringARawCaptureIsReportedByName) {
+  RunningDevice running(test::replayBoard(1, 3));
+  auto client = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(client.has_value()) << client.error();
+  running.control().injectTimeouts(0, 1);
+  auto pending = std::async(std::launch::async, [&] { return client->captureRaw(0b10U, 20s); });
+  running.serveOne();
+  const auto failed = pending.get();
+  ASSERT_FALSE(failed.has_value());
+  EXPECT_NE(failed.error().find("capture-raw: cam0: no frame from the simulated camera in time "
+                                "(timeout)"),
+            std::string::npos)
+      << failed.error();
+  EXPECT_EQ(running.device->counters().captureErrors, 1U);
+  EXPECT_EQ(running.boardHal->hal().trigger.active(), 0U) << "lines left on";
+  const auto next = captureServedHere(running, *client, 0b01U);
+  EXPECT_EQ(next.images.size(), 1U);
+}
+
 // Given a running device, `stripemux capture --sets none,proj0` writes the calibration file names
 // at the camera's size; an unknown id is a usage error naming the ids there are.
 TEST(CaptureSim, CaptureCommandWritesTheCalibrationNames) {
