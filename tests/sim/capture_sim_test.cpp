@@ -377,6 +377,58 @@ TEST(CaptureSim, GuidedCaptureWritesAPoseAndRefusesOneTooSimilar) {
   EXPECT_FALSE(fs::exists(second / "pose01"));
 }
 
+// A board that moves between a pose's off frame and its projector frames must not give a pose:
+// a board replaying A A A A then B B B B B B (one image per raw capture, the capture loop idle)
+// is still at captures 0-1, has moved by capture 4 (the off frame after the projector frames),
+// and is accepted at B: captures 5-6 still, 9 the same.
+TEST(CaptureSim, GuidedCaptureStartsAPoseOverWhenTheBoardMoved) {
+  const fs::path replay = scratch("moved_replay");
+  const fs::path shifted = fs::temp_directory_path() / "smx_capture_sim_test_checker_shifted.json";
+  {
+    std::ifstream in(checkerScene());
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    text.replace(text.find("[0.02, 0.0, 0.75]"), 17, "[0.06, 0.0, 0.75]");
+    std::ofstream(shifted) << text;
+  }
+  for (const auto& [scene, name] : {std::pair{checkerScene(), "a"}, std::pair{shifted, "b"}}) {
+    const auto run = cli({"sim", "--rig", kRig1.string(), "--scene", scene.string(), "--lit",
+                          "none", "--no-truth", "--out", (replay / name).string()});
+    ASSERT_EQ(run.code, 0) << run.err;
+  }
+  for (int k = 0; k < 10; ++k) {
+    fs::copy_file(replay / (k < 4 ? "a" : "b") / "cam0.png",
+                  replay / ("cam0_" + std::to_string(k) + ".png"));
+  }
+  config::Board board = renderBoard("plane");
+  board.config.sim.scene.clear();
+  board.config.sim.replayDir = replay;
+  RunningDevice running(std::move(board));
+  const std::jthread rawOnly([&](const std::stop_token& stop) {
+    while (!stop.stop_requested()) {
+      if (!running.device->serveRawCapture()) {
+        std::this_thread::sleep_for(1ms);
+      }
+    }
+  });
+  auto client = host::DeviceClient::connect(running.address(), 3000ms);
+  ASSERT_TRUE(client.has_value()) << client.error();
+  const fs::path dir = scratch("moved");
+  std::ostringstream out;
+  std::ostringstream err;
+  const auto summary =
+      host::captureCalibrationSet(*client, running.board.rig, guideOptions(1), dir, {out, err});
+  ASSERT_TRUE(summary.has_value()) << summary.error() << "\n" << out.str();
+  EXPECT_NE(out.str().find("pose00: the board moved while the projector frames were taken"),
+            std::string::npos)
+      << out.str();
+  EXPECT_EQ(running.control().framesDelivered(0), 10U);
+  const auto written = sim::readPngRgb8(dir / "pose00" / "cam0.png");
+  const auto b = sim::readPngRgb8(replay / "b" / "cam0.png");
+  ASSERT_TRUE(written.has_value()) << written.error();
+  ASSERT_TRUE(b.has_value());
+  EXPECT_EQ(written->pixels, b->pixels) << "pose00 is not the board where it held still";
+}
+
 // Given a scene without the target, the guided capture gives up on pose00 and says so.
 TEST(CaptureSim, GuidedCaptureSaysWhenTheTargetIsNeverFound) {
   RunningDevice running(renderBoard("plane"));

@@ -295,11 +295,30 @@ std::optional<std::string> tooSimilar(const BoardView& view, const std::vector<A
   return std::nullopt;
 }
 
-// Captures the pose's projector frames and writes every image of it.
-std::expected<void, std::string> writePose(DeviceClient& device, const algo::Rig& rig,
-                                           const RawCapture& off,
-                                           const CaptureGuideOptions& options,
-                                           const fs::path& poseDir) {
+// Captures the pose's projector frames, then the off frame again: every image of a pose must
+// show one board pose, so a board that moved meanwhile makes the pose start over (false).
+// Writes the pose's images only when it held still.
+std::expected<bool, std::string> capturePose(DeviceClient& device, const algo::Rig& rig,
+                                             const RawCapture& off, const Corners& corners,
+                                             const Target& target,
+                                             const CaptureGuideOptions& options,
+                                             const fs::path& poseDir) {
+  std::vector<RawCapture> lit;
+  for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
+    auto capture = device.captureRaw(1U << p, options.captureTimeout);
+    if (!capture) {
+      return Fail(rig.projectors[p].id + " on: " + capture.error());
+    }
+    lit.push_back(std::move(*capture));
+  }
+  const auto after = device.captureRaw(0, options.captureTimeout);
+  if (!after) {
+    return Fail(after.error());
+  }
+  const Corners again = findCorners(after->images.front(), after->width, after->height, target);
+  if (!(largestMove(corners, again) < options.stillPx)) {
+    return false;
+  }
   auto out = OutputFolder::create(poseDir);
   if (!out) {
     return Fail(out.error());
@@ -316,18 +335,17 @@ std::expected<void, std::string> writePose(DeviceClient& device, const algo::Rig
     return {};
   };
   if (auto ok = write(off, ""); !ok) {
-    return ok;
+    return Fail(ok.error());
   }
   for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
-    const auto lit = device.captureRaw(1U << p, options.captureTimeout);
-    if (!lit) {
-      return Fail(rig.projectors[p].id + " on: " + lit.error());
-    }
-    if (auto ok = write(*lit, rig.projectors[p].id + "."); !ok) {
-      return ok;
+    if (auto ok = write(lit[p], rig.projectors[p].id + "."); !ok) {
+      return Fail(ok.error());
     }
   }
-  return out->commit();
+  if (auto ok = out->commit(); !ok) {
+    return Fail(ok.error());
+  }
+  return true;
 }
 
 }  // namespace
@@ -403,8 +421,14 @@ std::expected<CaptureSummary, std::string> captureCalibrationSet(DeviceClient& d
         pose.cornersPerCamera.push_back(
             static_cast<int>(findCorners(off->images[c], off->width, off->height, *target).size()));
       }
-      if (auto written = writePose(device, rig, *off, options, dir / name); !written) {
-        return Fail(name + ": " + written.error());
+      const auto held = capturePose(device, rig, *off, corners, *target, options, dir / name);
+      if (!held) {
+        return Fail(name + ": " + held.error());
+      }
+      if (!*held) {
+        say("the board moved while the projector frames were taken; hold it still");
+        previous.clear();
+        continue;
       }
       accepted.push_back({name, view});
       coverage.add(corners, view);

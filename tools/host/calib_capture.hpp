@@ -12,9 +12,9 @@
 
 // The guided calibration capture (docs/cli.md, "capture --guided"): for each pose it watches
 // projector-off frames until the checkerboard is found in the first camera and holds still,
-// refuses a pose too like an earlier one, then captures the off frame and one frame per projector
-// into DIR/poseNN/ in the calibration layout (<cam>.png, <proj>.<cam>.png), and prints the
-// corners found and the coverage of the image and of tilts so far.
+// refuses a pose too like an earlier one, then captures one frame per projector and the off frame
+// again (the board must not have moved), writes DIR/poseNN/ in the calibration layout (<cam>.png,
+// <proj>.<cam>.png), and prints the corners found and the coverage of the image and tilts so far.
 namespace smx::host {
 
 struct CaptureGuideOptions {
