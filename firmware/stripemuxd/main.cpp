@@ -124,6 +124,7 @@ int run(const Options& opts) {
   timespec last{};
   clock_gettime(CLOCK_MONOTONIC, &last);
   while (!stop) {
+    (void)(*device)->serveRawCapture();  // between range captures, when a host asked for one
     (void)(*device)->captureOnce();
     if (opts.frames > 0 &&
         (*device)->counters().framesCaptured >= opts.frames * rig.cameras.size()) {

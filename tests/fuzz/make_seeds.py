@@ -177,6 +177,15 @@ def range_seeds():
     write("range_frame", "confidence_raw_5x3.bin", announce9 + raw9)
     write("range_frame", "confidence_rvl_5x3.bin", announce9 + rvl9)
     write("range_frame", "near_confidence_short_5x3.bin", announce9 + raw9[:-1])
+    # Raw-frame bands (bit 6 of the announcement's first byte; bit 5: projector mask 1), two
+    # records of [length u16, band] that complete one 5×3 camera.
+    def band(first_row, rows):
+        pixels = bytes((7 * k) & 0xFF for k in range(3 * width * rows))
+        payload = struct.pack("<BIHHHHQq", 0, 1, width, height, first_row, rows, 3, 1000) + pixels
+        return struct.pack("<H", len(payload)) + payload
+    announce_raw = struct.pack("<BHH", 0x60, width - 1, height - 1)
+    write("range_frame", "raw_bands_5x3.bin", announce_raw + band(0, 2) + band(2, 1))
+    write("range_frame", "near_raw_row_twice_5x3.bin", announce_raw + band(0, 2) + band(1, 2))
 
     # The protocol target: a first byte with bit 7 set asks it to seal [type, length u16,
     # payload] records into messages with correct headers.
@@ -189,6 +198,14 @@ def range_seeds():
     write("protocol", "sealed_hello_frames.bin", b"\x87" + frames)
     write("protocol", "sealed_frame_claims_65535.bin",
           b"\x90" + record(5, range_frame(0, 1, 65535, 65535, b"\x00")))
+    # capture-raw, then the bands of a 5×3 raw frame (rows 0–1 and 2), as docs/protocol.md says.
+    def raw_band(first_row, rows):
+        pixels = bytes((7 * k) & 0xFF for k in range(3 * width * rows))
+        return struct.pack("<BIHHHHQq", 0, 1, width, height, first_row, rows, 3, 1000) + pixels
+    write("protocol", "sealed_raw_capture.bin",
+          b"\x87" + record(1, hello) + record(10, struct.pack("<I", 1)) +
+          record(11, raw_band(0, 2)) + record(11, raw_band(2, 1)))
+    write("protocol", "sealed_raw_band_past_height.bin", b"\x90" + record(11, raw_band(2, 2)[:-15]))
 
 
 def main():

@@ -22,6 +22,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addInfoCommand(app, io, exitCode);
   addStreamCommand(app, io, exitCode);
   addCalibrateCommand(app, io, exitCode);
+  addCaptureCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -15,5 +15,6 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

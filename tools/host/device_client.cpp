@@ -224,4 +224,57 @@ std::expected<DeviceEvent, std::string> DeviceClient::next(std::chrono::millisec
   }
 }
 
+std::expected<RawCapture, std::string> DeviceClient::captureRaw(std::uint32_t projectorsMask,
+                                                                std::chrono::milliseconds timeout) {
+  if (projectorsMask >> static_cast<unsigned>(info_.projectors) != 0) {
+    return Fail("capture-raw: the device has " + std::to_string(info_.projectors) +
+                " projectors; mask " + std::to_string(projectorsMask) + " names others");
+  }
+  auto assembler =
+      RawFrameAssembler::create({info_.cameras, info_.width, info_.height}, projectorsMask);
+  if (!assembler) {
+    return Fail(assembler.error());
+  }
+  if (auto sent = send(protocol::encode(protocol::CaptureRaw{projectorsMask}, out_)); !sent) {
+    return Fail(sent.error());
+  }
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!assembler->complete()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    const auto silent = [&] {
+      return Fail("no raw frames from the device within " + std::to_string(timeout.count()) +
+                  " ms; firmware " + info_.firmwareVersion +
+                  " may predate raw capture (capture-raw, docs/protocol.md): update it");
+    };
+    if (left.count() <= 0) {
+      return silent();
+    }
+    auto message = nextMessage(left);
+    if (!message) {
+      return Fail(message.error());
+    }
+    const auto& got = *message;
+    if (!got.has_value()) {
+      return silent();
+    }
+    const auto& [type, payload] = *got;
+    if (type == MessageType::kError) {
+      const auto error = protocol::decodeError(payload);
+      if (error && std::string_view(error->text).find("does not know") != std::string_view::npos) {
+        return Fail("the device's firmware " + info_.firmwareVersion +
+                    " cannot capture raw frames (it does not know capture-raw): update it");
+      }
+      return Fail(deviceError(payload));
+    }
+    if (type != MessageType::kRawFrame) {
+      continue;  // range frames and statistics of a stream
+    }
+    if (auto added = assembler->add(payload); !added) {
+      return Fail(added.error());
+    }
+  }
+  return assembler->take();
+}
+
 }  // namespace smx::host

@@ -9,13 +9,15 @@
 #include <vector>
 
 #include "range_frame.hpp"
+#include "raw_frames.hpp"
 #include "smx/algo/rig.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/stream_parser.hpp"
 
 // The host tool's side of the protocol (docs/protocol.md): connect, hello → capabilities,
-// start/stop the stream, read range frames and statistics. Errors are messages for the user.
+// start/stop the stream, read range frames and statistics, capture raw frames. Errors are
+// messages for the user.
 namespace smx::host {
 
 struct DeviceInfo {
@@ -54,6 +56,11 @@ class DeviceClient {
   [[nodiscard]] std::expected<void, std::string> stopStream();
   [[nodiscard]] std::expected<void, std::string> requestStatistics();
   [[nodiscard]] std::expected<DeviceEvent, std::string> next(std::chrono::milliseconds timeout);
+  // One raw frame per camera with exactly the projectors of `projectorsMask` lit (bit i: the
+  // rig's projector i). Range frames and statistics that arrive meanwhile are skipped. A device
+  // that refuses, or says nothing within `timeout`, is an error saying so.
+  [[nodiscard]] std::expected<RawCapture, std::string> captureRaw(
+      std::uint32_t projectorsMask, std::chrono::milliseconds timeout);
   // Bad messages from the device so far (skipped).
   [[nodiscard]] std::uint64_t protocolErrors() const { return parser_->counters().errors; }
   void close() { socket_.close(); }

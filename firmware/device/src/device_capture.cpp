@@ -1,4 +1,7 @@
 // The capture loop: per frame integer-only (the pipeline) and allocation-free.
+#include <algorithm>
+#include <array>
+#include <cstdio>
 #include <thread>
 
 #include "smx/device/device.hpp"
@@ -82,8 +85,85 @@ void Device::queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uin
   ++counters_.framesQueued;
 }
 
+bool Device::serveRawCapture() {
+  auto requested = RawState::kRequested;
+  if (!rawState_.compare_exchange_strong(requested, RawState::kCapturing)) {
+    return false;
+  }
+  rawSize_ = captureRaw(rawMask_);
+  ++counters_.rawCaptures;
+  rawState_ = RawState::kReady;  // publishes raw_ to the network loop
+  return true;
+}
+
+std::size_t Device::rawError(std::string_view what, const hal::HalError& error) {
+  ++counters_.captureErrors;
+  std::array<char, 256> text{};
+  const int length = std::snprintf(text.data(), text.size(), "capture-raw: %.*s: %s (%s)",
+                                   static_cast<int>(what.size()), what.data(), error.message,
+                                   hal::toString(error.code));
+  const protocol::ErrorMessage message{
+      protocol::ErrorCode::kInternal,
+      std::string_view(text.data(), static_cast<std::size_t>(std::clamp(length, 0, 255)))};
+  const auto encoded = protocol::encode(message, raw_);
+  return encoded ? encoded->size() : 0;
+}
+
+std::size_t Device::captureRaw(std::uint32_t mask) {
+  if (auto on = hal_.trigger.set(mask); !on) {
+    return rawError("trigger lines", on.error());
+  }
+  if (leadNs_ > 0) {
+    hal_.clock.sleepUntilNs(hal_.clock.nowNs() + leadNs_);
+  }
+  std::size_t acquired = 0;
+  std::size_t size = 0;
+  bool failed = false;
+  for (hal::Camera* camera : hal_.cameras) {
+    auto frame = camera->acquire(options_.acquireTimeoutNs);
+    if (!frame) {
+      size = rawError(camera->id(), frame.error());
+      failed = true;
+      break;
+    }
+    frames_[acquired++] = *frame;
+  }
+  (void)hal_.trigger.set(0);
+  counters_.framesCaptured += acquired;
+  const std::uint64_t number = counters_.rawCaptures;
+  for (std::size_t i = 0; !failed && i < acquired; ++i) {
+    const algo::ConstRgbView image = frames_[i].image;
+    const int band = protocol::rawFrameBandRows(image.width());
+    for (int row = 0; !failed && row < image.height(); row += band) {
+      const protocol::RawFrameHeader header{
+          .camera = static_cast<std::uint8_t>(i),
+          .projectorsMask = mask,
+          .firstRow = static_cast<std::uint16_t>(row),
+          .rows = static_cast<std::uint16_t>(std::min(band, image.height() - row)),
+          .capture = number,
+          .captureTimestampNs = frames_[i].timestampNs};
+      const auto message = protocol::encodeRawFrame(header, image, std::span(raw_).subspan(size));
+      if (!message) {
+        // raw_ holds every camera's bands at the board's size; a frame of another size is not
+        // the camera the board describes.
+        size = rawError(hal_.cameras[i]->id(),
+                        hal::HalError{hal::HalErrc::kInvalidArgument,
+                                      "frame does not match the board's camera size"});
+        failed = true;
+        continue;
+      }
+      size += message->size();
+    }
+  }
+  for (std::size_t i = 0; i < acquired; ++i) {
+    (void)hal_.cameras[i]->release(frames_[i]);
+  }
+  return size;
+}
+
 void Device::runCapture(const std::atomic<bool>& stop) {
   while (!stop) {
+    (void)serveRawCapture();
     const auto captured = captureOnce();
     if (!captured && captured.error().code == hal::HalErrc::kDisconnected) {
       // Try to bring every camera back, then capture again; the host keeps its connection.

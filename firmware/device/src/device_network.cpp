@@ -83,6 +83,25 @@ void Device::onMessage(const protocol::Message& message) {
         sendControl(*stats);
       }
       return;
+    case MessageType::kCaptureRaw: {
+      const auto request = protocol::decodeCaptureRaw(message.payload);
+      if (!request) {
+        refuse(protocol::ErrorCode::kBadRequest, request.error().message);
+      } else if (!helloSeen_) {
+        refuse(protocol::ErrorCode::kBadRequest, "capture-raw before hello");
+      } else if ((request->projectorsMask & ~allProjectorsMask_) != 0) {
+        refuse(protocol::ErrorCode::kBadRequest,
+               "capture-raw: a projector bit beyond the board's projectors");
+      } else if (rawState_ != RawState::kIdle) {
+        refuse(protocol::ErrorCode::kBusy, "capture-raw: the previous raw capture is not sent yet");
+      } else {
+        // Only this thread leaves kIdle, so the mask is in place before the capture loop looks.
+        rawMask_ = request->projectorsMask;
+        rawConnection_ = counters_.connections.load();
+        rawState_ = RawState::kRequested;
+      }
+      return;
+    }
     default:
       refuse(protocol::ErrorCode::kBadRequest, "that message type is not for the device");
       return;
@@ -97,8 +116,15 @@ void Device::dropConnection() {
   }
   sending_ = {};
   sendingFrame_ = false;
+  sendingRaw_ = false;
   controlSize_ = 0;
   queue_.clear();
+  // A raw capture asked for by this host is not sent to the next (the capture loop may still
+  // be taking it: pumpSend() drops it by its connection number).
+  for (const RawState done : {RawState::kRequested, RawState::kReady, RawState::kSending}) {
+    auto state = done;
+    (void)rawState_.compare_exchange_strong(state, RawState::kIdle);
+  }
 }
 
 void Device::pumpSend(std::int64_t nowNs) {
@@ -108,6 +134,15 @@ void Device::pumpSend(std::int64_t nowNs) {
       if (controlSize_ > 0) {
         sending_ = std::span(control_).first(controlSize_);
         sendingFrame_ = false;
+      } else if (rawState_ == RawState::kReady) {
+        if (rawConnection_ != counters_.connections) {
+          rawState_ = RawState::kIdle;  // for a host that has left
+          continue;
+        }
+        rawState_ = RawState::kSending;
+        sending_ = std::span(raw_).first(rawSize_);
+        sendingFrame_ = false;
+        sendingRaw_ = true;
       } else if (streaming_) {
         sending_ = queue_.beginSend();
         sendingFrame_ = !sending_.empty();
@@ -136,6 +171,9 @@ void Device::pumpSend(std::int64_t nowNs) {
     if (sendingFrame_) {
       queue_.finishSend();
       ++counters_.framesSent;
+    } else if (sendingRaw_) {
+      sendingRaw_ = false;
+      rawState_ = RawState::kIdle;
     } else {
       // Replies added while these were sent move to the front.
       std::memmove(control_.data(), control_.data() + sent_, controlSize_ - sent_);
@@ -165,8 +203,8 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     }
     return;
   }
-  const bool wantWrite =
-      !sending_.empty() || controlSize_ > 0 || (streaming_ && queue_.queued() > 0);
+  const bool wantWrite = !sending_.empty() || controlSize_ > 0 || rawState_ == RawState::kReady ||
+                         (streaming_ && queue_.queued() > 0);
   (void)link.waitForIo(wantWrite, timeoutNs);
 
   const std::int64_t now = hal_.clock.nowNs();
@@ -183,12 +221,20 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     const auto next = parser_.next();
     if (!next) {
       ++counters_.protocolErrors;
+      std::array<std::byte, 256> reply{};
       if (next.error().code == protocol::ProtocolErrc::kUnsupportedVersion) {
-        std::array<std::byte, 256> reply{};
         if (const auto error =
                 protocol::encode(protocol::ErrorMessage{protocol::ErrorCode::kUnsupportedVersion,
                                                         "this device speaks protocol version 1"},
                                  reply)) {
+          sendControl(*error);
+        }
+      } else if (next.error().code == protocol::ProtocolErrc::kUnknownType) {
+        // A newer host asks for something this firmware cannot do: say so rather than stay mute.
+        if (const auto error = protocol::encode(
+                protocol::ErrorMessage{protocol::ErrorCode::kBadRequest,
+                                       "a message type this firmware does not know"},
+                reply)) {
           sendControl(*error);
         }
       }

@@ -1,4 +1,5 @@
 // Device::create: everything the loops need, allocated once.
+#include <algorithm>
 #include <cmath>
 
 #include "smx/config/rig_json.hpp"
@@ -98,6 +99,10 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
   }
   device->capabilities_.resize(encoded->size());
   device->control_.resize(device->capabilities_.size() + kControlBytes);
+  // Every camera's bands of one raw capture, or the error that replaces them.
+  device->raw_.resize(std::max<std::size_t>(
+      kControlBytes, rig.cameras.size() * protocol::rawFrameBound(rig.cameras.front().width,
+                                                                  rig.cameras.front().height)));
   return device;
 }
 

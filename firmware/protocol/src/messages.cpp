@@ -200,6 +200,37 @@ ProtocolResult<std::span<const std::byte>> encode(const ErrorMessage& m, std::sp
   });
 }
 
+ProtocolResult<std::span<const std::byte>> encode(const CaptureRaw& m, std::span<std::byte> out) {
+  return build(MessageType::kCaptureRaw, out, [&](ByteWriter& w) { w.put(m.projectorsMask); });
+}
+
+ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
+                                                          algo::ConstRgbView image,
+                                                          std::span<std::byte> out) {
+  if (image.width() < 1 || image.height() < 1 || image.width() > 0xFFFF ||
+      image.height() > 0xFFFF) {
+    return protocolFail(ProtocolErrc::kMalformed, "raw frame: image size outside 1..65535");
+  }
+  if (header.rows == 0 || header.firstRow + header.rows > image.height()) {
+    return protocolFail(ProtocolErrc::kMalformed, "raw frame: band outside the image");
+  }
+  header.width = static_cast<std::uint16_t>(image.width());
+  header.height = static_cast<std::uint16_t>(image.height());
+  return build(MessageType::kRawFrame, out, [&](ByteWriter& w) {
+    w.put(header.camera);
+    w.put(header.projectorsMask);
+    w.put(header.width);
+    w.put(header.height);
+    w.put(header.firstRow);
+    w.put(header.rows);
+    w.put(header.capture);
+    w.put(static_cast<std::uint64_t>(header.captureTimestampNs));
+    for (int y = header.firstRow; y < header.firstRow + header.rows; ++y) {
+      w.putBytes(std::as_bytes(image.row(y)));
+    }
+  });
+}
+
 ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type, std::span<std::byte> out) {
   return build(type, out, [](ByteWriter&) {});
 }
@@ -303,6 +334,44 @@ ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload) {
     return protocolFail(ProtocolErrc::kMalformed, "payload of a message that has none");
   }
   return {};
+}
+
+ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  CaptureRaw m{in.get<std::uint32_t>()};
+  if (auto ok = finished(in); !ok) {
+    return std::unexpected(ok.error());
+  }
+  return m;
+}
+
+ProtocolResult<RawFrameView> decodeRawFrame(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  RawFrameView m;
+  m.header.camera = in.get<std::uint8_t>();
+  m.header.projectorsMask = in.get<std::uint32_t>();
+  m.header.width = in.get<std::uint16_t>();
+  m.header.height = in.get<std::uint16_t>();
+  m.header.firstRow = in.get<std::uint16_t>();
+  m.header.rows = in.get<std::uint16_t>();
+  m.header.capture = in.get<std::uint64_t>();
+  m.header.captureTimestampNs = static_cast<std::int64_t>(in.get<std::uint64_t>());
+  m.pixels = in.rest();
+  if (!in.ok()) {
+    return protocolFail(ProtocolErrc::kMalformed, "raw frame is shorter than its header");
+  }
+  const RawFrameHeader& h = m.header;
+  if (h.width == 0 || h.height == 0 || h.rows == 0) {
+    return protocolFail(ProtocolErrc::kMalformed, "raw frame: zero size or zero rows");
+  }
+  if (std::size_t{h.firstRow} + h.rows > h.height) {
+    return protocolFail(ProtocolErrc::kMalformed, "raw frame: rows run past the frame's height");
+  }
+  if (m.pixels.size() != 3 * std::size_t{h.width} * h.rows) {
+    return protocolFail(ProtocolErrc::kMalformed,
+                        "raw frame: pixel bytes do not match rows x width x 3");
+  }
+  return m;
 }
 
 ProtocolResult<RangeFrameView> decodeRangeFrame(std::span<const std::byte> payload,

@@ -10,7 +10,7 @@ namespace smx::protocol {
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
   return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-         value <= static_cast<std::uint8_t>(MessageType::kRangeFrameConfidence);
+         value <= static_cast<std::uint8_t>(MessageType::kRawFrame);
 }
 
 const char* toString(MessageType type) {
@@ -33,6 +33,10 @@ const char* toString(MessageType type) {
       return "error";
     case MessageType::kRangeFrameConfidence:
       return "range-frame-confidence";
+    case MessageType::kCaptureRaw:
+      return "capture-raw";
+    case MessageType::kRawFrame:
+      return "raw-frame";
   }
   return "unknown";
 }

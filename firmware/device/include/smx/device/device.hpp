@@ -18,8 +18,8 @@
 
 // The appliance (docs/firmware.md): a capture loop that triggers the projectors, captures every
 // camera, runs the pipeline and queues range frames, and a network loop that serves one host
-// (hello → capabilities, start/stop stream, statistics) and sends the queue. Each loop runs on
-// its own thread; after create() neither allocates.
+// (hello → capabilities, start/stop stream, statistics, raw capture) and sends the queue. Each
+// loop runs on its own thread; after create() neither allocates.
 namespace smx::device {
 
 struct DeviceOptions {
@@ -45,6 +45,7 @@ struct DeviceCounters {
   std::atomic<std::uint64_t> protocolErrors = 0;   // bad messages from the host
   std::atomic<std::uint64_t> connections = 0;      // hosts served so far
   std::atomic<std::uint64_t> idleDisconnects = 0;  // hosts dropped after the idle timeout
+  std::atomic<std::uint64_t> rawCaptures = 0;      // raw captures served (capture-raw)
   std::atomic<std::uint64_t> decodeTimeUsTotal = 0;
   std::atomic<std::uint32_t> decodeTimeUsLast = 0;
 };
@@ -61,7 +62,11 @@ class Device {
   // One capture: trigger, acquire every camera, decode, queue (while a host streams). A camera
   // error is counted and returned; the caller goes on with the next capture.
   [[nodiscard]] hal::HalResult<void> captureOnce();
-  // Runs captureOnce() until stop is set.
+  // Serves a raw capture the host asked for, if one waits: lights the asked projectors, takes
+  // one frame per camera and leaves the bands (or an error) for the network loop to send.
+  // Returns whether one was served. Allocation-free.
+  bool serveRawCapture();
+  // Runs serveRawCapture() and captureOnce() until stop is set.
   void runCapture(const std::atomic<bool>& stop);
   // One round of the network loop: accept, receive and answer, send; waits at most timeoutNs.
   void serviceNetwork(std::int64_t timeoutNs);
@@ -75,6 +80,8 @@ class Device {
   // connection only, the rest since start-up (docs/protocol.md, message 7).
   [[nodiscard]] protocol::Statistics statisticsForHost() const;
   [[nodiscard]] bool streaming() const { return streaming_; }
+  // A host's capture-raw waits for the capture loop.
+  [[nodiscard]] bool rawCaptureRequested() const { return rawState_ == RawState::kRequested; }
   [[nodiscard]] std::size_t arenaBytes() const;
   [[nodiscard]] const hal::Hal& hal() const { return hal_; }
 
@@ -88,6 +95,10 @@ class Device {
   Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options);
   void decodeCamera(int camera);
   void queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs);
+  // Captures with `mask` lit and writes the bands of every camera into raw_; returns their size
+  // (an error message instead when a camera or the trigger fails).
+  std::size_t captureRaw(std::uint32_t mask);
+  std::size_t rawError(std::string_view what, const hal::HalError& error);
   void onMessage(const protocol::Message& message);
   void sendControl(std::span<const std::byte> message);
   void dropConnection();
@@ -110,6 +121,15 @@ class Device {
   std::atomic<protocol::Compression> compression_ = protocol::Compression::kRvl;
   std::atomic<bool> confidence_ = false;  // the host asked for the confidence planes
 
+  // Raw capture: the network thread takes a request (kIdle → kRequested), the capture loop
+  // serves it (→ kCapturing → kReady), the network thread sends raw_ (→ kSending → kIdle).
+  enum class RawState : std::uint8_t { kIdle, kRequested, kCapturing, kReady, kSending };
+  std::atomic<RawState> rawState_ = RawState::kIdle;
+  std::atomic<std::uint32_t> rawMask_ = 0;
+  std::atomic<std::uint64_t> rawConnection_ = 0;  // the host that asked (counters_.connections)
+  std::vector<std::byte> raw_;                    // every camera's bands, allocated at create()
+  std::size_t rawSize_ = 0;                       // written before kReady, read after
+
   // Network thread only.
   protocol::StreamParser parser_;
   std::vector<std::byte> capabilities_;  // encoded once at create()
@@ -117,6 +137,7 @@ class Device {
   std::size_t controlSize_ = 0;
   std::span<const std::byte> sending_;  // the message being sent (control or queue slot)
   bool sendingFrame_ = false;
+  bool sendingRaw_ = false;
   std::size_t sent_ = 0;
   bool helloSeen_ = false;
   bool hadClient_ = false;

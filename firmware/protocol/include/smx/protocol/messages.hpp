@@ -74,6 +74,48 @@ struct Statistics {
   std::uint32_t decodeTimeUsMean = 0;
 };
 
+// Ask for one raw frame of every camera with exactly these projectors lit (bit i: the rig's
+// projector i; 0: all off).
+struct CaptureRaw {
+  std::uint32_t projectorsMask = 0;
+};
+
+// One band of rows of one camera's raw frame (message kRawFrame): RGB8, rows × width pixels.
+struct RawFrameHeader {
+  std::uint8_t camera = 0;           // index into the rig's cameras
+  std::uint32_t projectorsMask = 0;  // the projectors lit during the exposure
+  std::uint16_t width = 0;           // of the whole frame
+  std::uint16_t height = 0;
+  std::uint16_t firstRow = 0;  // the band: rows firstRow … firstRow + rows - 1
+  std::uint16_t rows = 0;
+  std::uint64_t capture = 0;            // the device's raw capture number, from 0 at start-up
+  std::int64_t captureTimestampNs = 0;  // device clock, the camera's frame timestamp
+};
+
+struct RawFrameView {
+  RawFrameHeader header;
+  std::span<const std::byte> pixels;  // rows × width × 3 bytes, r g b, row by row
+};
+
+inline constexpr std::size_t kRawFrameHeaderBytes = 29;
+// A band carries at most this many bytes of pixels (and always at least one row), so a frame of
+// any camera fits the receiver's payload limit in pieces that keep the host's buffer small.
+inline constexpr std::size_t kRawBandPixelBytes = std::size_t{1} << 20U;
+
+// Rows in each band of a frame `width` pixels wide (the last band may have fewer).
+[[nodiscard]] constexpr int rawFrameBandRows(int width) {
+  const std::size_t rowBytes = 3 * static_cast<std::size_t>(width < 1 ? 1 : width);
+  return rowBytes >= kRawBandPixelBytes ? 1 : static_cast<int>(kRawBandPixelBytes / rowBytes);
+}
+
+// Bytes of every band message of one width × height frame, headers included.
+[[nodiscard]] constexpr std::size_t rawFrameBound(int width, int height) {
+  const int band = rawFrameBandRows(width);
+  const auto bands = static_cast<std::size_t>((height + band - 1) / band);
+  return bands * (kHeaderBytes + kRawFrameHeaderBytes) +
+         3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+}
+
 enum class ErrorCode : std::uint16_t {
   kUnsupportedVersion = 1,
   kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
@@ -97,6 +139,13 @@ struct ErrorMessage {
                                                                 std::span<std::byte> out);
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const ErrorMessage& m,
                                                                 std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const CaptureRaw& m,
+                                                                std::span<std::byte> out);
+// The band `header.firstRow`, `header.rows` of `image` as a raw-frame message; the header's
+// width and height are taken from the image. kMalformed for a band outside the image.
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
+                                                                        algo::ConstRgbView image,
+                                                                        std::span<std::byte> out);
 // A message without payload: stop-stream, get-statistics.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type,
                                                                      std::span<std::byte> out);
@@ -122,6 +171,10 @@ struct ErrorMessage {
 [[nodiscard]] ProtocolResult<Statistics> decodeStatistics(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<ErrorMessage> decodeError(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload);
+// Checks the band against its own frame size (inside it, pixels = rows × width × 3); the
+// receiver checks the frame size against what the device announced.
+[[nodiscard]] ProtocolResult<RawFrameView> decodeRawFrame(std::span<const std::byte> payload);
 // The payload of a kRangeFrame or a kRangeFrameConfidence message (`type` says which).
 [[nodiscard]] ProtocolResult<RangeFrameView> decodeRangeFrame(
     std::span<const std::byte> payload, MessageType type = MessageType::kRangeFrame);

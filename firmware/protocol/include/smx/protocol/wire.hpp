@@ -25,6 +25,7 @@ inline constexpr std::uint8_t kProtocolVersion = 1;
 inline constexpr std::size_t kHeaderBytes = 16;
 inline constexpr std::uint16_t kDefaultPort = 5555;
 // The largest payload either side sends: a 1280x960 range frame uncompressed, with room.
+// Raw frames come in bands of rows well below it (messages.hpp, kRawBandPixelBytes).
 inline constexpr std::size_t kMaxPayloadBytes = 4U << 20U;
 
 enum class MessageType : std::uint8_t {
@@ -38,6 +39,8 @@ enum class MessageType : std::uint8_t {
   kError = 8,          // device → host: a request was refused, with the reason
   // device → host, only to a host that asked for it: a range frame with its confidence plane
   kRangeFrameConfidence = 9,
+  kCaptureRaw = 10,  // host → device: one raw frame per camera with the given projectors on
+  kRawFrame = 11,    // device → host: a band of rows of one camera's raw frame (RGB8)
 };
 
 [[nodiscard]] bool isKnown(MessageType type);
