@@ -30,9 +30,9 @@ Mat3 rotation(const Vec3& w) {
 
 Mat3 times(const Mat3& a, const Mat3& b) {
   Mat3 m{};
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      for (int k = 0; k < 3; ++k) {
+  for (std::size_t r = 0; r < 3; ++r) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t k = 0; k < 3; ++k) {
         m[r * 3 + c] += a[r * 3 + k] * b[k * 3 + c];
       }
     }
