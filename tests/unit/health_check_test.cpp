@@ -68,10 +68,10 @@ TEST(HealthDisagreement, NoiseAloneAgrees) {
 
 // A projector turned about its optical axis tilts its stripes: no mean disagreement, a trend.
 TEST(HealthDisagreement, ATrendWithoutOffsetDisagrees) {
-  const Disagreement d = fitDisagreement(planeField(0, 0.8, 0, 0.3), {});
+  const Disagreement d = fitDisagreement(planeField(0, 1.5, 0, 0.3), {});
   ASSERT_TRUE(d.enough);
-  // The RMS of 0.8·x over x uniform in [−1, 1] is 0.8/√3.
-  EXPECT_NEAR(d.systematicMm, 0.8 / std::sqrt(3.0), 0.02);
+  // The RMS of 1.5·x over x uniform in [−1, 1] is 1.5/√3.
+  EXPECT_NEAR(d.systematicMm, 1.5 / std::sqrt(3.0), 0.02);
   EXPECT_TRUE(d.disagrees);
 }
 

@@ -45,7 +45,7 @@ int partner(const Comparison& c, int p) {
 // Verdicts from the comparisons (docs/health-check.md, "What can be named").
 struct Judge {
   const algo::Rig& rig;
-  const std::vector<Comparison>& comparisons;
+  std::vector<Comparison>& comparisons;
   std::vector<ProjectorHealth> out;
 
   [[nodiscard]] const std::string& id(int p) const {
@@ -134,7 +134,7 @@ struct Judge {
   // Two projectors that only disagree with each other: the disagreement's shape may decide.
   std::expected<void, std::string> byShape(const std::vector<CameraDepths>& depths,
                                            const CheckOptions& options) {
-    for (const Comparison& c : comparisons) {
+    for (Comparison& c : comparisons) {
       const int p = c.projector;
       const int q = c.otherProjector;
       if (c.kind != Comparison::Kind::kProjectorPair || !c.disagreement.disagrees ||
@@ -148,6 +148,7 @@ struct Judge {
       if (!a) {
         return std::unexpected(a.error());
       }
+      c.shapeResidualMm = a->residualMm;
       const std::string fits = "pose fits leave " + fixed(a->residualMm[0]) + " mm (" + id(p) +
                                ") and " + fixed(a->residualMm[1]) + " mm (" + id(q) + ")";
       if (a->named < 0) {
@@ -244,7 +245,7 @@ std::expected<CheckReport, std::string> checkRig(const algo::Rig& rig,
       for (int q = p + 1; q < projectors; ++q) {
         report.comparisons.push_back(
             {Comparison::Kind::kProjectorPair, d.camera, d.camera, p, q,
-             fitDisagreement(projectorPairField(d, p, q), options.thresholds)});
+             fitDisagreement(projectorPairField(d, p, q), options.thresholds), std::nullopt});
       }
     }
   }
@@ -253,7 +254,8 @@ std::expected<CheckReport, std::string> checkRig(const algo::Rig& rig,
       for (int p = 0; p < projectors; ++p) {
         report.comparisons.push_back(
             {Comparison::Kind::kCameraPair, depths[i].camera, depths[j].camera, p, p,
-             fitDisagreement(crossCameraField(rig, depths[i], depths[j], p), options.thresholds)});
+             fitDisagreement(crossCameraField(rig, depths[i], depths[j], p), options.thresholds),
+             std::nullopt});
       }
     }
   }

@@ -115,8 +115,12 @@ std::string healthMarkdown(const std::vector<HealthCase>& cases, const std::stri
   for (const auto& [rig, a] : alarms) {
     md << "| " << rig << " | " << percent(a[0], a[1]) << " |\n";
   }
-  md << "\n## Every case\n\n| rig | scene | moved | drift | verdict | largest disagreement, mm |\n"
-     << "|---|---|---|---|---|---|\n";
+  md << "\n## Every case\n\n*Pose fits*: with two projectors and one camera, the RMS (mm) that "
+     << "fitting each projector's small pose change to their disagreement leaves "
+     << "(docs/health-check.md); a projector is named when its fit leaves at most half the "
+     << "other's.\n\n"
+     << "| rig | scene | moved | drift | verdict | largest disagreement, mm | pose fits, mm |\n"
+     << "|---|---|---|---|---|---|---|\n";
   for (const HealthCase& c : cases) {
     double largest = 0;
     for (const auto& h : c.report.projectors) {
@@ -125,10 +129,15 @@ std::string healthMarkdown(const std::vector<HealthCase>& cases, const std::stri
     std::ostringstream mm;
     mm.setf(std::ios::fixed);
     mm.precision(2);
-    mm << largest;
+    mm << largest << " | ";
+    for (const Comparison& k : c.report.comparisons) {
+      if (k.shapeResidualMm) {
+        mm << (*k.shapeResidualMm)[0] << " / " << (*k.shapeResidualMm)[1];
+      }
+    }
     md << "| " << c.rigFile << " | " << c.scene << " | "
-       << (c.projector < 0 ? "–" : "proj" + std::to_string(c.projector)) << " | " << c.drift
-       << " | " << c.report.summary << " | " << mm.str() << " |\n";
+       << (c.projector < 0 ? "–" : c.report.projectors[static_cast<std::size_t>(c.projector)].id)
+       << " | " << c.drift << " | " << c.report.summary << " | " << mm.str() << " |\n";
   }
   return md.str();
 }
