@@ -106,6 +106,7 @@ struct Judge {
     }
     bool overlap = false;
     std::vector<std::string> unexplained;
+    std::vector<std::string> explained;  // disagreeing partners named (or judged) elsewhere
     for (const Comparison& c : comparisons) {
       if (c.kind != Comparison::Kind::kProjectorPair || !involves(c, p) || !c.disagreement.enough) {
         continue;
@@ -113,8 +114,12 @@ struct Judge {
       overlap = true;
       note(p, c);
       const int q = partner(c, p);
-      if (c.disagreement.disagrees && !named[static_cast<std::size_t>(q)] &&
-          !judgedByCameras[static_cast<std::size_t>(q)]) {
+      if (!c.disagreement.disagrees) {
+        continue;
+      }
+      if (named[static_cast<std::size_t>(q)] || judgedByCameras[static_cast<std::size_t>(q)]) {
+        explained.push_back(id(q));
+      } else {
         unexplained.push_back(id(q));
       }
     }
@@ -123,7 +128,9 @@ struct Judge {
       h.reason = "overlaps no other projector enough to compare";
     } else if (unexplained.empty()) {
       h.verdict = Verdict::kGood;
-      h.reason = "agrees with the projectors it overlaps (or disagrees only with a named one)";
+      h.reason = explained.empty() ? "agrees with every projector it overlaps"
+                                   : "disagrees only with " + explained.front() +
+                                         ", which the other comparisons blame";
     } else {
       h.verdict = Verdict::kSuspect;
       h.reason = "disagrees with " + unexplained.front() + "; " + id(p) + " or " +

@@ -88,3 +88,17 @@ std::vector<NamedDrift> specifiedDrifts(const algo::Rig& rig, int projector, int
 }
 
 }  // namespace smx::health
+
+namespace smx::health {
+
+std::vector<NamedDrift> limitDrifts(const algo::Rig& rig, int projector) {
+  constexpr double kShiftM = 0.001;
+  const double a = rig.projectors.at(static_cast<std::size_t>(projector)).pattern.angleDeg *
+                   std::numbers::pi / 180.0;
+  return {
+      {"1 mm along the optical axis", {{0, 0, kShiftM}, {}}},
+      {"1 mm along the stripes", {{-std::sin(a) * kShiftM, std::cos(a) * kShiftM, 0}, {}}},
+  };
+}
+
+}  // namespace smx::health

@@ -29,4 +29,8 @@ struct NamedDrift {
 [[nodiscard]] std::vector<NamedDrift> specifiedDrifts(const algo::Rig& rig, int projector,
                                                       int camera = 0);
 
+// Drifts at the check's limits, for the figures: 1 mm along the optical axis (about half the
+// disagreement of the specified drifts) and 1 mm along the projector's stripes (none at all).
+[[nodiscard]] std::vector<NamedDrift> limitDrifts(const algo::Rig& rig, int projector);
+
 }  // namespace smx::health
