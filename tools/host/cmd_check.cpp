@@ -67,8 +67,8 @@ Json toJson(const algo::Rig& rig, const health::CheckReport& report) {
       j["threshold_mm"] = d.thresholdMm;
       j["disagrees"] = d.disagrees;
     }
-    if (c.shapeResidualMm) {
-      j["pose_fit_residual_mm"] = *c.shapeResidualMm;
+    if (c.shapeFitted) {
+      j["pose_fit_residual_mm"] = c.shapeResidualMm;
     }
     comparisons.push_back(j);
   }

@@ -97,28 +97,28 @@ std::expected<Columns, std::string> poseColumns(const algo::Rig& rig, const Came
 // RMS residual of the least-squares fit of the columns to the block medians (ridge-regularised:
 // a pose change along a projector's stripes moves nothing, and its column is zero).
 double fitResidual(const Columns& columns, const Disagreement& d) {
-  constexpr std::size_t n = kPoseParameters;
-  std::array<std::array<double, n + 1>, n> m{};
+  constexpr std::size_t kN = kPoseParameters;
+  std::array<std::array<double, kN + 1>, kN> m{};
   for (std::size_t b = 0; b < columns.size(); ++b) {
-    for (std::size_t r = 0; r < n; ++r) {
-      for (std::size_t c = 0; c < n; ++c) {
+    for (std::size_t r = 0; r < kN; ++r) {
+      for (std::size_t c = 0; c < kN; ++c) {
         m[r][c] += columns[b][r] * columns[b][c];
       }
-      m[r][n] += columns[b][r] * d.inliers[b].mm;
+      m[r][kN] += columns[b][r] * d.inliers[b].mm;
     }
   }
   double trace = 0;
-  for (std::size_t r = 0; r < n; ++r) {
+  for (std::size_t r = 0; r < kN; ++r) {
     trace += m[r][r];
   }
-  for (std::size_t r = 0; r < n; ++r) {
+  for (std::size_t r = 0; r < kN; ++r) {
     m[r][r] += 1e-9 * trace + 1e-12;
   }
-  for (std::size_t c = 0; c < n; ++c) {  // Gauss–Jordan; the ridge keeps it positive definite
-    for (std::size_t r = 0; r < n; ++r) {
+  for (std::size_t c = 0; c < kN; ++c) {  // Gauss–Jordan; the ridge keeps it positive definite
+    for (std::size_t r = 0; r < kN; ++r) {
       if (r != c) {
         const double f = m[r][c] / m[c][c];
-        for (std::size_t k = c; k <= n; ++k) {
+        for (std::size_t k = c; k <= kN; ++k) {
           m[r][k] -= f * m[c][k];
         }
       }
@@ -127,8 +127,8 @@ double fitResidual(const Columns& columns, const Disagreement& d) {
   double sumSquares = 0;
   for (std::size_t b = 0; b < columns.size(); ++b) {
     double model = 0;
-    for (std::size_t r = 0; r < n; ++r) {
-      model += columns[b][r] * m[r][n] / m[r][r];
+    for (std::size_t r = 0; r < kN; ++r) {
+      model += columns[b][r] * m[r][kN] / m[r][r];
     }
     const double e = d.inliers[b].mm - model;
     sumSquares += e * e;

@@ -155,6 +155,7 @@ struct Judge {
       if (!a) {
         return std::unexpected(a.error());
       }
+      c.shapeFitted = true;
       c.shapeResidualMm = a->residualMm;
       const std::string fits = "pose fits leave " + fixed(a->residualMm[0]) + " mm (" + id(p) +
                                ") and " + fixed(a->residualMm[1]) + " mm (" + id(q) + ")";
@@ -251,8 +252,14 @@ std::expected<CheckReport, std::string> checkRig(const algo::Rig& rig,
     for (int p = 0; p < projectors; ++p) {
       for (int q = p + 1; q < projectors; ++q) {
         report.comparisons.push_back(
-            {Comparison::Kind::kProjectorPair, d.camera, d.camera, p, q,
-             fitDisagreement(projectorPairField(d, p, q), options.thresholds), std::nullopt});
+            {Comparison::Kind::kProjectorPair,
+             d.camera,
+             d.camera,
+             p,
+             q,
+             fitDisagreement(projectorPairField(d, p, q), options.thresholds),
+             false,
+             {}});
       }
     }
   }
@@ -260,9 +267,14 @@ std::expected<CheckReport, std::string> checkRig(const algo::Rig& rig,
     for (std::size_t j = i + 1; j < depths.size(); ++j) {
       for (int p = 0; p < projectors; ++p) {
         report.comparisons.push_back(
-            {Comparison::Kind::kCameraPair, depths[i].camera, depths[j].camera, p, p,
+            {Comparison::Kind::kCameraPair,
+             depths[i].camera,
+             depths[j].camera,
+             p,
+             p,
              fitDisagreement(crossCameraField(rig, depths[i], depths[j], p), options.thresholds),
-             std::nullopt});
+             false,
+             {}});
       }
     }
   }

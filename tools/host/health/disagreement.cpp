@@ -51,7 +51,7 @@ std::vector<Block> blockMedians(const DisagreementField& field, const Thresholds
       if (static_cast<int>(values.size()) < t.minBlockPixels) {
         continue;
       }
-      const double n = static_cast<double>(values.size());
+      const auto n = static_cast<double>(values.size());
       blocks.push_back({bx, by, (sx / n - 0.5 * (field.width - 1)) / (0.5 * field.width),
                         (sy / n - 0.5 * (field.height - 1)) / (0.5 * field.height),
                         median(values)});
@@ -113,6 +113,7 @@ Disagreement fitDisagreement(const DisagreementField& field, const Thresholds& t
     return d;
   }
   std::vector<double> values;
+  values.reserve(blocks.size());
   for (const Block& b : blocks) {
     values.push_back(b.mm);
   }
@@ -121,6 +122,7 @@ Disagreement fitDisagreement(const DisagreementField& field, const Thresholds& t
   double sigma = 0;
   for (int round = 0; round < kFitRounds; ++round) {
     std::vector<double> absResiduals;
+    absResiduals.reserve(blocks.size());
     for (const Block& b : blocks) {
       absResiduals.push_back(std::abs(b.mm - plane[0] - plane[1] * b.x - plane[2] * b.y));
     }
@@ -140,7 +142,7 @@ Disagreement fitDisagreement(const DisagreementField& field, const Thresholds& t
       sumSquares += v * v;
     }
   }
-  const double n = static_cast<double>(d.inliers.size());
+  const auto n = static_cast<double>(d.inliers.size());
   d.offsetMm = plane[0];
   d.slopeXMm = plane[1];
   d.slopeYMm = plane[2];

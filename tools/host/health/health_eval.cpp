@@ -79,7 +79,11 @@ std::vector<HealthCase> runHealthEval(const HealthEvalOptions& options) {
         }
       }
       if (options.progress) {
-        options.progress("health: " + scene + " on " + rigFile);
+        std::string line = "health: ";
+        line += scene;
+        line += " on ";
+        line += rigFile;
+        options.progress(line);
       }
     }
   }
@@ -99,7 +103,6 @@ std::string healthMarkdown(const std::vector<HealthCase>& cases, const std::stri
      << "## Drifts\n\n| rig | drift | flagged | named | wrong |\n|---|---|---|---|---|\n";
   std::map<std::pair<std::string, std::string>, std::array<int, 4>> drifts;
   std::map<std::string, std::array<int, 2>> alarms;
-  std::vector<std::string> order;
   for (const HealthCase& c : cases) {
     if (c.projector < 0) {
       auto& a = alarms[c.rigFile];
@@ -137,8 +140,8 @@ std::string healthMarkdown(const std::vector<HealthCase>& cases, const std::stri
     mm.precision(2);
     mm << largest << " | ";
     for (const Comparison& k : c.report.comparisons) {
-      if (k.shapeResidualMm) {
-        mm << (*k.shapeResidualMm)[0] << " / " << (*k.shapeResidualMm)[1];
+      if (k.shapeFitted) {
+        mm << k.shapeResidualMm[0] << " / " << k.shapeResidualMm[1];
       }
     }
     md << "| " << c.rigFile << " | " << c.scene << " | "

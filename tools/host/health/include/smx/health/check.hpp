@@ -3,7 +3,6 @@
 #include <array>
 #include <cstddef>
 #include <expected>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,9 +39,11 @@ struct Comparison {
   int projector = 0;
   int otherProjector = 0;  // kProjectorPair: depth(projector) − depth(otherProjector)
   Disagreement disagreement;
-  // Two projectors that only disagree with each other: the RMS left by fitting each one's small
-  // pose change to the disagreement (attribution.hpp), projector's then otherProjector's.
-  std::optional<std::array<double, 2>> shapeResidualMm;
+  // Two projectors that only disagree with each other (shapeFitted): the RMS left by fitting
+  // each one's small pose change to the disagreement (attribution.hpp), projector's then
+  // otherProjector's.
+  bool shapeFitted = false;
+  std::array<double, 2> shapeResidualMm{};
 };
 
 enum class Verdict : std::uint8_t {
