@@ -18,6 +18,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addSimCommand(app, io, exitCode);
   addDemuxCommand(app, io, exitCode);
   addDecodeCommand(app, io, exitCode);
+  addCheckCommand(app, io, exitCode);
   addEvalCommand(app, io, exitCode);
   addInfoCommand(app, io, exitCode);
   addStreamCommand(app, io, exitCode);

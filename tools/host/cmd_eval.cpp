@@ -2,7 +2,8 @@
 //                [--supersampling N] [--cases N] [--no-projector-distortion]
 // The evaluation suite: the named scenes rendered by the simulator, decoded by the firmware's
 // pipeline and scored against the truth; writes DIR/results.md and DIR/results/*.png
-// (docs/results.md is this command's output with the defaults).
+// (docs/results.md is this command's output with the defaults); `--only health` writes
+// DIR/health.md instead (docs/health.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,7 +15,9 @@
 
 #include "commands.hpp"
 #include "eval_report.hpp"
+#include "output_folder.hpp"
 #include "smx/eval/suite.hpp"
+#include "smx/health/health_eval.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/scene.hpp"
 
@@ -57,7 +60,37 @@ std::string commandLine(const EvalOptions& o) {
   return c;
 }
 
+// `--only health`: the health check's figures, DIR/health.md (health_eval.hpp).
+int runHealthEval(const EvalOptions& o, const CliStreams& io) {
+  health::HealthEvalOptions options;
+  options.scenes = o.scenes;
+  options.seed = o.seed;
+  options.supersampling = o.supersampling;
+  options.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
+  try {
+    const auto cases = health::runHealthEval(options);
+    auto out = OutputFolder::create(o.out);
+    if (!out) {
+      io.err << "stripemux eval: " << out.error() << '\n';
+      return kExitDeviceOrIo;
+    }
+    if (auto ok = out->writeText("health.md", health::healthMarkdown(cases, commandLine(o)));
+        !ok || !out->commit()) {
+      io.err << "stripemux eval: cannot write " << (o.out / "health.md").string() << '\n';
+      return kExitDeviceOrIo;
+    }
+  } catch (const std::exception& e) {
+    io.err << "stripemux eval: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  io.out << "wrote " << (o.out / "health.md").string() << '\n';
+  return kExitOk;
+}
+
 int runEval(const EvalOptions& o, const CliStreams& io) {
+  if (o.only.size() == 1 && o.only.front() == "health") {
+    return runHealthEval(o, io);
+  }
   eval::SuiteOptions suite;
   suite.seed = o.seed;
   suite.supersampling = o.supersampling;
@@ -75,7 +108,8 @@ int runEval(const EvalOptions& o, const CliStreams& io) {
       }
       if (!found) {
         io.err << "stripemux eval: unknown section '" << name
-               << "' (sections: scenes, flat, table2, baselines, sweeps, realism)\n";
+               << "' (sections: scenes, flat, table2, baselines, sweeps, realism; or health "
+               << "alone)\n";
         return kExitUsage;
       }
     }
@@ -117,8 +151,10 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       "eval",
       "Render the scene suite, decode it and score it against the truth: results.md + plots");
   cmd->add_option("--out", options->out, "Folder for results.md and results/ (default docs)");
-  cmd->add_option("--only", options->only,
-                  "Sections to run: scenes, flat, table2, baselines, sweeps, realism (default all)")
+  cmd->add_option(
+         "--only", options->only,
+         "Sections to run: scenes, flat, table2, baselines, sweeps, realism (default all); "
+         "or health alone (writes health.md)")
       ->delimiter(',');
   cmd->add_option("--scene", options->scenes,
                   "Only the suite's runs of these named scenes (repeatable)");

@@ -11,6 +11,7 @@ void addPatternCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addDemuxCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addCheckCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);

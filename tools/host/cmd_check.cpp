@@ -1,0 +1,178 @@
+// stripemux check --rig RIG.json --images DIR [--report DIR2] [--json]
+// The rig's health check on one frame with every projector lit: DIR/<cam>.png per camera (as
+// `stripemux sim` writes them); per projector a verdict, good / drifted / not enough overlap
+// (docs/health-check.md, docs/cli.md).
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "camera_images.hpp"
+#include "commands.hpp"
+#include "output_folder.hpp"
+#include "smx/health/check.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+// The check ran and a projector is not good (docs/cli.md).
+constexpr int kExitNotHealthy = 4;
+
+struct CheckOptions {
+  fs::path rig;
+  fs::path images;
+  std::optional<fs::path> report;
+  bool json = false;
+};
+
+const char* kindName(health::Comparison::Kind kind) {
+  return kind == health::Comparison::Kind::kProjectorPair ? "projector_pair" : "camera_pair";
+}
+
+Json toJson(const algo::Rig& rig, const health::CheckReport& report) {
+  Json projectors = Json::array();
+  for (const auto& h : report.projectors) {
+    projectors.push_back({{"id", h.id},
+                          {"verdict", health::verdictName(h.verdict)},
+                          {"disagreement_mm", h.disagreementMm},
+                          {"reason", h.reason}});
+  }
+  Json comparisons = Json::array();
+  for (const auto& c : report.comparisons) {
+    const auto& d = c.disagreement;
+    Json j = {{"kind", kindName(c.kind)},
+              {"camera", rig.cameras[static_cast<std::size_t>(c.camera)].id}};
+    if (c.kind == health::Comparison::Kind::kProjectorPair) {
+      j["projectors"] = {rig.projectors[static_cast<std::size_t>(c.projector)].id,
+                         rig.projectors[static_cast<std::size_t>(c.otherProjector)].id};
+    } else {
+      j["projector"] = rig.projectors[static_cast<std::size_t>(c.projector)].id;
+      j["other_camera"] = rig.cameras[static_cast<std::size_t>(c.otherCamera)].id;
+    }
+    j["pixels"] = d.pixels;
+    j["blocks"] = d.blocks;
+    j["enough_overlap"] = d.enough;
+    if (d.enough) {
+      j["offset_mm"] = d.offsetMm;
+      j["slope_x_mm"] = d.slopeXMm;
+      j["slope_y_mm"] = d.slopeYMm;
+      j["sigma_mm"] = d.sigmaMm;
+      j["systematic_mm"] = d.systematicMm;
+      j["threshold_mm"] = d.thresholdMm;
+      j["disagrees"] = d.disagrees;
+    }
+    if (c.shapeFitted) {
+      j["pose_fit_residual_mm"] = c.shapeResidualMm;
+    }
+    comparisons.push_back(j);
+  }
+  return {{"format", "stripemux-check/1"},
+          {"healthy", report.healthy},
+          {"summary", report.summary},
+          {"projectors", projectors},
+          {"comparisons", comparisons}};
+}
+
+std::string toText(const health::CheckReport& report) {
+  std::ostringstream s;
+  for (const auto& h : report.projectors) {
+    s << h.id << ": " << health::verdictName(h.verdict);
+    if (h.verdict != health::Verdict::kNoOverlap) {
+      s.setf(std::ios::fixed);
+      s.precision(2);
+      s << " (" << h.disagreementMm << " mm)";
+    }
+    s << " — " << h.reason << "\n";
+  }
+  s << report.summary << "\n";
+  return s.str();
+}
+
+int runCheck(const CheckOptions& opts, const CliStreams& io) {
+  const auto fail = [&](int code, const std::string& message) {
+    io.err << "stripemux check: " << message << "\n";
+    return code;
+  };
+  // One image per camera that has one in the folder; loadRigAndImages checks the rig and them.
+  auto rigOnly = loadRigAndImages(opts.rig, {});
+  if (!rigOnly) {
+    return fail(kExitBadInput, rigOnly.error());
+  }
+  std::vector<std::string> specs;
+  for (const auto& camera : rigOnly->rig.cameras) {
+    const fs::path file = opts.images / (camera.id + ".png");
+    std::error_code ec;
+    if (fs::exists(file, ec)) {
+      specs.push_back(camera.id + "=" + file.string());
+    }
+  }
+  if (specs.empty()) {
+    return fail(kExitBadInput, opts.images.string() + ": no camera image (expected " +
+                                   rigOnly->rig.cameras.front().id + ".png and one per camera)");
+  }
+  const auto loaded = loadRigAndImages(opts.rig, specs);
+  if (!loaded) {
+    return fail(kExitBadInput, loaded.error());
+  }
+  std::vector<sim::RgbImage> images;
+  for (const CameraImage& input : loaded->images) {
+    auto image = readCameraImage(input.file, loaded->rig.cameras[input.camera]);
+    if (!image) {
+      return fail(kExitBadInput, image.error());
+    }
+    if (auto colour = checkHasColour(input.file, *image); !colour) {
+      return fail(kExitBadInput, colour.error());
+    }
+    images.push_back(std::move(*image));
+  }
+  std::vector<health::CameraFrame> frames;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    frames.push_back({loaded->images[i].camera, images[i].view()});
+  }
+  const auto report = health::checkRig(loaded->rig, frames);
+  if (!report) {
+    return fail(kExitBadInput, opts.rig.string() + ": " + report.error());
+  }
+  const Json json = toJson(loaded->rig, *report);
+  const std::string jsonText = json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+  if (opts.report) {
+    auto out = OutputFolder::create(*opts.report);
+    if (!out) {
+      return fail(kExitDeviceOrIo, out.error());
+    }
+    if (auto ok = out->writeText("check.json", jsonText); !ok) {
+      return fail(kExitDeviceOrIo, ok.error());
+    }
+    if (auto ok = out->writeText("check.txt", toText(*report)); !ok) {
+      return fail(kExitDeviceOrIo, ok.error());
+    }
+    if (auto ok = out->commit(); !ok) {
+      return fail(kExitDeviceOrIo, ok.error());
+    }
+  }
+  io.out << (opts.json ? jsonText : toText(*report));
+  return report->healthy ? kExitOk : kExitNotHealthy;
+}
+
+}  // namespace
+
+void addCheckCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<CheckOptions>();
+  auto* cmd = app.add_subcommand(
+      "check", "Health check: do the projectors' depths agree where they overlap? (one frame)");
+  cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
+  cmd->add_option("--images", opts->images,
+                  "Folder with one frame's camera images, all projectors lit: <camera id>.png")
+      ->required();
+  cmd->add_option("--report", opts->report, "Folder for check.json and check.txt");
+  cmd->add_flag("--json", opts->json, "Print the report as JSON (stripemux-check/1)");
+  cmd->callback([opts, &io, &exitCode] { exitCode = runCheck(*opts, io); });
+}
+
+}  // namespace smx::host
