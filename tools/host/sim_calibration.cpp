@@ -314,13 +314,14 @@ TargetSheet targetSheet(const calib::Target& target) {
   sheet.height = target.rows + 1 + 2 * kTargetMarginSquares;
   sheet.grey.assign(static_cast<std::size_t>(sheet.width) * static_cast<std::size_t>(sheet.height),
                     kPaperWhite);
+  const auto margin = static_cast<std::size_t>(kTargetMarginSquares);
   // Square (i, j), i = 0 … cols, j = 0 … rows, is black when i + j is even: the square before the
   // first inner corner (top left) is black.
   for (int j = 0; j <= target.rows; ++j) {
     for (int i = 0; i <= target.cols; ++i) {
       if ((i + j) % 2 == 0) {
-        const auto row = static_cast<std::size_t>(j + kTargetMarginSquares);
-        const auto col = static_cast<std::size_t>(i + kTargetMarginSquares);
+        const auto row = static_cast<std::size_t>(j) + margin;
+        const auto col = static_cast<std::size_t>(i) + margin;
         sheet.grey[row * static_cast<std::size_t>(sheet.width) + col] = kPrintedBlack;
       }
     }
