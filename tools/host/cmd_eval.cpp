@@ -3,7 +3,7 @@
 // The evaluation suite: the named scenes rendered by the simulator, decoded by the firmware's
 // pipeline and scored against the truth; writes DIR/results.md and DIR/results/*.png
 // (docs/results.md is this command's output with the defaults); `--only health` writes
-// DIR/health.md instead (docs/health.md).
+// DIR/health.md instead (docs/health.md), `--only calibration` DIR/calibration-results.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration_eval.hpp"
 #include "commands.hpp"
 #include "eval_report.hpp"
 #include "output_folder.hpp"
@@ -87,9 +88,42 @@ int runHealthEval(const EvalOptions& o, const CliStreams& io) {
   return kExitOk;
 }
 
+// `--only calibration`: calibration on simulated captures against the real rig,
+// DIR/calibration-results.md (calibration_eval.hpp). Captures stay in DIR/calibration-work/.
+int runCalibrationEval(const EvalOptions& o, const CliStreams& io) {
+  CalibrationEvalOptions options;
+  options.scenes = o.scenes;
+  options.seed = o.seed;
+  options.work = o.out / "calibration-work";
+  options.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
+  try {
+    const auto cases = runCalibrationEval(options);
+    auto out = OutputFolder::create(o.out);
+    if (!out) {
+      io.err << "stripemux eval: " << out.error() << '\n';
+      return kExitDeviceOrIo;
+    }
+    if (auto ok = out->writeText("calibration-results.md",
+                                 calibrationMarkdown(cases, options, commandLine(o)));
+        !ok || !out->commit()) {
+      io.err << "stripemux eval: cannot write " << (o.out / "calibration-results.md").string()
+             << '\n';
+      return kExitDeviceOrIo;
+    }
+  } catch (const std::exception& e) {
+    io.err << "stripemux eval: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  io.out << "wrote " << (o.out / "calibration-results.md").string() << '\n';
+  return kExitOk;
+}
+
 int runEval(const EvalOptions& o, const CliStreams& io) {
   if (o.only.size() == 1 && o.only.front() == "health") {
     return runHealthEval(o, io);
+  }
+  if (o.only.size() == 1 && o.only.front() == "calibration") {
+    return runCalibrationEval(o, io);
   }
   eval::SuiteOptions suite;
   suite.seed = o.seed;
@@ -108,7 +142,8 @@ int runEval(const EvalOptions& o, const CliStreams& io) {
       }
       if (!found) {
         io.err << "stripemux eval: unknown section '" << name
-               << "' (sections: scenes, flat, table2, baselines, sweeps, realism; or health "
+               << "' (sections: scenes, flat, table2, baselines, sweeps, realism; or health or "
+                  "calibration "
                << "alone)\n";
         return kExitUsage;
       }
@@ -154,7 +189,7 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option(
          "--only", options->only,
          "Sections to run: scenes, flat, table2, baselines, sweeps, realism (default all); "
-         "or health alone (writes health.md)")
+         "or health or calibration alone (writes health.md, calibration-results.md)")
       ->delimiter(',');
   cmd->add_option("--scene", options->scenes,
                   "Only the suite's runs of these named scenes (repeatable)");

@@ -222,6 +222,11 @@ std::expected<JointFigures, std::string> refineJointly(
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CentrePrior, 1, 3>(
                                  new CentrePrior(nominal.projectors[p], constants[p])),
                              nullptr, projs[p].centre.data());
+    const auto& d = nominal.projectors[p].dist;
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<detail::LensPrior, 4, 4>(
+            new detail::LensPrior{.nominal = {d[0], d[1], d[2], d[3]}, .scale = 1.0}),
+        nullptr, projs[p].lens.data());
   }
   // The first camera is the world frame; lens terms its own fit fixed stay fixed.
   problem.SetParameterBlockConstant(cams[0].rotation.data());

@@ -39,7 +39,7 @@ struct StripeResidual {
 };
 
 void solve(const std::vector<const StripeSample*>& used, const ProjectorConstants& constants,
-           ProjectorParams& params, const CentrePrior& prior) {
+           ProjectorParams& params, const CentrePrior& prior, const detail::LensPrior& lens) {
   ceres::Problem problem;
   for (const StripeSample* s : used) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<StripeResidual, 1, 3, 3, 2, 4>(
@@ -50,6 +50,9 @@ void solve(const std::vector<const StripeSample*>& used, const ProjectorConstant
   problem.AddResidualBlock(
       new ceres::AutoDiffCostFunction<CentrePrior, 1, 3>(new CentrePrior(prior)), nullptr,
       params.centre.data());
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<detail::LensPrior, 4, 4>(new detail::LensPrior(lens)),
+      nullptr, params.lens.data());
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   options.max_num_iterations = 100;
@@ -122,6 +125,11 @@ std::expected<ProjectorFit, std::string> fitProjector(const algo::Projector& nom
   const ProjectorConstants constants(nominal);
   ProjectorParams params = detail::paramsOf(nominal);
   const CentrePrior prior(nominal, constants);
+  // The data residuals here are in projector px: the prior in the same unit, at the scatter a
+  // decoded boundary has (kHuberPx is a few of them).
+  const detail::LensPrior lensPrior{
+      .nominal = {nominal.dist[0], nominal.dist[1], nominal.dist[2], nominal.dist[3]},
+      .scale = kHuberPx / 2};
 
   std::vector<const StripeSample*> used;
   used.reserve(samples.size());
@@ -130,7 +138,7 @@ std::expected<ProjectorFit, std::string> fitProjector(const algo::Projector& nom
   }
   // Solve, drop what lies beyond kOutlierSigmas robust deviations, solve again.
   for (int round = 0; round < 3; ++round) {
-    solve(used, constants, params, prior);
+    solve(used, constants, params, prior, lensPrior);
     const algo::Projector current = detail::projectorOf(nominal, constants, params);
     std::vector<double> abs;
     abs.reserve(used.size());
