@@ -218,103 +218,108 @@ std::vector<CalibrationCase> runCalibrationEval(const CalibrationEvalOptions& op
   std::vector<std::string> scenes = options.scenes.empty() ? sim::namedScenes() : options.scenes;
   std::vector<CalibrationCase> cases;
   for (std::size_t r = 0; r < options.rigs.size(); ++r) {
-    CalibrationCase c;
-    c.rig = options.rigs[r];
-    const algo::Rig nominal = eval::loadExampleRig(c.rig);
-    const algo::Rig real = drawRealRig(nominal, options.seed * 1000 + r);
-    const fs::path dir = options.work / fs::path(c.rig).stem();
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    const fs::path realFile = dir / "real.json";
-    std::ofstream(realFile) << config::toJson(real);
-    const fs::path captures = dir / "captures";
-    if (options.progress) {
-      options.progress(c.rig + ": rendering " + std::to_string(options.poses) + " poses");
-    }
-    std::ostringstream out;
-    std::ostringstream err;
-    const std::vector<std::string> args = {"sim",
-                                           "--rig",
-                                           realFile.string(),
-                                           "--calibration",
-                                           std::to_string(options.poses),
-                                           "--out",
-                                           captures.string(),
-                                           "--realism",
-                                           "--seed",
-                                           std::to_string(options.seed + r)};
-    if (runCli(args, {out, err}) != kExitOk) {
-      throw std::runtime_error(c.rig + ": rendering the captures failed: " + err.str());
-    }
-    if (options.progress) {
-      options.progress(c.rig + ": solving");
-    }
-    const auto start = std::chrono::steady_clock::now();
-    const auto solved = calib::calibrate(nominal, captures);
-    c.solveSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!solved) {
-      c.failure = solved.error();
-      cases.push_back(std::move(c));
-      continue;
-    }
-    c.verdict = solved->verdict;
-    std::ofstream(dir / "calibrated.json") << config::toJson(solved->rig);
-    for (std::size_t i = 0; i < real.cameras.size(); ++i) {
-      c.cameraRmsPx = std::max(c.cameraRmsPx, solved->cameras[i].rmsPx);
-      c.cameras.push_back(cameraError(real.cameras[i], solved->rig.cameras[i]));
-    }
-    for (std::size_t p = 0; p < real.projectors.size(); ++p) {
-      c.projectorRmsPx = std::max(c.projectorRmsPx, solved->projectors[p].rmsPx);
-      DeviceError e = projectorError(real.projectors[p], solved->rig.projectors[p]);
-      measureStripeDepth(real, solved->rig, p, e);
-      c.projectors.push_back(e);
-    }
-    for (const std::string& scene : scenes) {
+    for (const int poses : options.poseCounts) {
+      CalibrationCase c;
+      c.rig = options.rigs[r];
+      c.poses = poses;
+      const algo::Rig nominal = eval::loadExampleRig(c.rig);
+      const algo::Rig real = drawRealRig(nominal, options.seed * 1000 + r);
+      const fs::path dir =
+          options.work / (fs::path(c.rig).stem().string() + "-" + std::to_string(poses));
+      fs::remove_all(dir);
+      fs::create_directories(dir);
+      const fs::path realFile = dir / "real.json";
+      std::ofstream(realFile) << config::toJson(real);
+      const fs::path captures = dir / "captures";
       if (options.progress) {
-        options.progress(c.rig + ": " + scene);
+        options.progress(c.rig + ": rendering " + std::to_string(poses) + " poses");
       }
-      eval::SimRequest request;
-      request.seed = options.seed;
-      const eval::SimFrame frame = eval::renderSimFrame(real, eval::loadNamedScene(scene), request);
-      const eval::Mask region = eval::litRegion(frame, {.smooth = true});
-      const auto realRun = eval::runPipeline(frame, 0);
-      auto calRun = eval::makePipeline(solved->rig, 0, eval::evalPipelineOptions());
-      if (!calRun->pipeline->run(frame.image.view())) {
-        throw std::runtime_error(c.rig + ": " + scene + ": the calibrated rig's pipeline failed");
+      std::ostringstream out;
+      std::ostringstream err;
+      const std::vector<std::string> args = {"sim",
+                                             "--rig",
+                                             realFile.string(),
+                                             "--calibration",
+                                             std::to_string(poses),
+                                             "--out",
+                                             captures.string(),
+                                             "--realism",
+                                             "--seed",
+                                             std::to_string(options.seed + r)};
+      if (runCli(args, {out, err}) != kExitOk) {
+        throw std::runtime_error(c.rig + ": rendering the captures failed: " + err.str());
       }
-      c.scenes.push_back({.scene = scene,
-                          .real = eval::scoreMerged(frame, 0, *realRun->pipeline, region),
-                          .calibrated = eval::scoreMerged(frame, 0, *calRun->pipeline, region)});
+      if (options.progress) {
+        options.progress(c.rig + ": solving");
+      }
+      const auto start = std::chrono::steady_clock::now();
+      const auto solved = calib::calibrate(nominal, captures);
+      c.solveSeconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!solved) {
+        c.failure = solved.error();
+        cases.push_back(std::move(c));
+        continue;
+      }
+      c.verdict = solved->verdict;
+      std::ofstream(dir / "calibrated.json") << config::toJson(solved->rig);
+      for (std::size_t i = 0; i < real.cameras.size(); ++i) {
+        c.cameraRmsPx = std::max(c.cameraRmsPx, solved->cameras[i].rmsPx);
+        c.cameras.push_back(cameraError(real.cameras[i], solved->rig.cameras[i]));
+      }
+      for (std::size_t p = 0; p < real.projectors.size(); ++p) {
+        c.projectorRmsPx = std::max(c.projectorRmsPx, solved->projectors[p].rmsPx);
+        DeviceError e = projectorError(real.projectors[p], solved->rig.projectors[p]);
+        measureStripeDepth(real, solved->rig, p, e);
+        c.projectors.push_back(e);
+      }
+      for (const std::string& scene : scenes) {
+        if (options.progress) {
+          options.progress(c.rig + ": " + scene);
+        }
+        eval::SimRequest request;
+        request.seed = options.seed;
+        const eval::SimFrame frame =
+            eval::renderSimFrame(real, eval::loadNamedScene(scene), request);
+        const eval::Mask region = eval::litRegion(frame, {.smooth = true});
+        const auto realRun = eval::runPipeline(frame, 0);
+        auto calRun = eval::makePipeline(solved->rig, 0, eval::evalPipelineOptions());
+        if (!calRun->pipeline->run(frame.image.view())) {
+          throw std::runtime_error(c.rig + ": " + scene + ": the calibrated rig's pipeline failed");
+        }
+        c.scenes.push_back({.scene = scene,
+                            .real = eval::scoreMerged(frame, 0, *realRun->pipeline, region),
+                            .calibrated = eval::scoreMerged(frame, 0, *calRun->pipeline, region)});
+      }
+      cases.push_back(std::move(c));
     }
-    cases.push_back(std::move(c));
   }
   return cases;
 }
 
 std::string calibrationMarkdown(const std::vector<CalibrationCase>& cases,
-                                const CalibrationEvalOptions& options, const std::string& command) {
+                                const std::string& command) {
   std::ostringstream s;
   s << "# Calibration results\n\n"
     << "Generated by `" << command << "`; do not edit. How calibration works and what it "
     << "cannot determine: [calibration.md](calibration.md).\n\n"
     << "For each example rig of `boards/sim`, a real rig is drawn near it (every device but the "
     << "first camera moved 2–10 mm and turned 0.5–2°, focal lengths ±2 %, principal points "
-    << "±8 px, lens distortion on cameras and projectors), " << options.poses
-    << " poses of the default printed target are rendered with the realistic optics "
-    << "(`stripemux sim --calibration " << options.poses << " --realism`, the paper's noise), "
-    << "and `stripemux calibrate` solves them with the example rig as the nominal.\n\n"
+    << "±8 px, lens distortion on cameras and projectors), N poses of the default printed "
+    << "target are rendered with the realistic optics (`stripemux sim --calibration N "
+    << "--realism`, the paper's noise; every sixth pose partly out of view), and "
+    << "`stripemux calibrate` solves them with the example rig as the nominal.\n\n"
     << "## Fits\n\n"
-    << "| rig | verdict | camera RMS (px) | projector RMS (projector px) | solve (s) |\n"
-    << "|---|---|---|---|---|\n";
+    << "| rig | poses | verdict | camera RMS (px) | projector RMS (projector px) | solve (s) |\n"
+    << "|---|---|---|---|---|---|\n";
   for (const auto& c : cases) {
     if (!c.failure.empty()) {
-      s << "| " << c.rig << " | failed: " << c.failure << " | | | " << fixed(c.solveSeconds, 0)
-        << " |\n";
+      s << "| " << c.rig << " | " << c.poses << " | failed: " << c.failure << " | | | "
+        << fixed(c.solveSeconds, 0) << " |\n";
       continue;
     }
-    s << "| " << c.rig << " | " << c.verdict << " | " << fixed(c.cameraRmsPx, 3) << " | "
-      << fixed(c.projectorRmsPx, 3) << " | " << fixed(c.solveSeconds, 0) << " |\n";
+    s << "| " << c.rig << " | " << c.poses << " | " << c.verdict << " | " << fixed(c.cameraRmsPx, 3)
+      << " | " << fixed(c.projectorRmsPx, 3) << " | " << fixed(c.solveSeconds, 0) << " |\n";
   }
   s << "\n## Devices against the real rig\n\n"
     << "Cameras: focal length and principal point (px), centre (mm), largest axis angle (°). "
@@ -322,18 +327,18 @@ std::string calibrationMarkdown(const std::vector<CalibrationCase>& cases,
     << "centre's error along them is shown apart), and the depth the calibrated rig "
     << "triangulates from exact stripe coordinates minus the true depth, over the first "
     << "camera's image at 0.6–1.2 m (RMS and largest, mm).\n\n"
-    << "| rig | device | focal | principal point | centre | centre along stripes | axes | "
-       "depth RMS | depth max |\n"
-    << "|---|---|---|---|---|---|---|---|---|\n";
+    << "| rig | poses | device | focal | principal point | centre | centre along stripes | "
+       "axes | depth RMS | depth max |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : cases) {
     for (const auto& e : c.cameras) {
-      s << "| " << c.rig << " | " << e.id << " | " << fixed(e.focalPx, 2) << " | "
-        << fixed(e.principalPx, 2) << " | " << fixed(e.centreMm, 2) << " | | "
+      s << "| " << c.rig << " | " << c.poses << " | " << e.id << " | " << fixed(e.focalPx, 2)
+        << " | " << fixed(e.principalPx, 2) << " | " << fixed(e.centreMm, 2) << " | | "
         << fixed(e.axesDeg, 3) << " | | |\n";
     }
     for (const auto& e : c.projectors) {
-      s << "| " << c.rig << " | " << e.id << " | " << fixed(e.focalPx, 2) << " | "
-        << fixed(e.principalPx, 2) << " | " << fixed(e.centreMm, 2) << " | "
+      s << "| " << c.rig << " | " << c.poses << " | " << e.id << " | " << fixed(e.focalPx, 2)
+        << " | " << fixed(e.principalPx, 2) << " | " << fixed(e.centreMm, 2) << " | "
         << fixed(e.centreAlongMm, 2) << " | " << fixed(e.axesDeg, 3) << " | "
         << fixed(e.depthRmsMm, 3) << " | " << fixed(e.depthMaxMm, 3) << " |\n";
     }
@@ -341,13 +346,13 @@ std::string calibrationMarkdown(const std::vector<CalibrationCase>& cases,
   s << "\n## Named scenes decoded with the real and the calibrated rig\n\n"
     << "The first camera's frame of each named scene rendered with the real rig, decoded with "
     << "each; merged depth over lit smooth pixels (docs/results.md's \"smooth\" region).\n\n"
-    << "| rig | scene | RMSE real (mm) | RMSE calibrated (mm) | ratio | gross real | gross "
-       "calibrated | mean error calibrated (mm) |\n"
-    << "|---|---|---|---|---|---|---|---|\n";
+    << "| rig | poses | scene | RMSE real (mm) | RMSE calibrated (mm) | ratio | gross real | "
+       "gross calibrated | mean error calibrated (mm) |\n"
+    << "|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : cases) {
     for (const auto& d : c.scenes) {
-      s << "| " << c.rig << " | " << d.scene << " | " << fixed(d.real.rmseMm, 3) << " | "
-        << fixed(d.calibrated.rmseMm, 3) << " | "
+      s << "| " << c.rig << " | " << c.poses << " | " << d.scene << " | " << fixed(d.real.rmseMm, 3)
+        << " | " << fixed(d.calibrated.rmseMm, 3) << " | "
         << fixed(d.real.rmseMm > 0 ? d.calibrated.rmseMm / d.real.rmseMm : 0, 3) << " | "
         << fixed(100 * d.real.grossRate, 3) << " % | " << fixed(100 * d.calibrated.grossRate, 3)
         << " % | " << fixed(d.calibrated.meanErrorMm, 3) << " |\n";

@@ -20,7 +20,9 @@ struct CalibrationEvalOptions {
   std::vector<std::string> rigs = {"rig_2proj_1cam.json", "rig_2proj_2cam.json",
                                    "rig_3proj_1cam.json", "rig_3proj_2cam.json"};
   std::vector<std::string> scenes;  // named scenes decoded with both rigs; empty: all
-  int poses = 12;
+  // Each rig is solved from this many poses of the target: the 12, and twice that, which
+  // shows how much of the error is the few views' uncertainty.
+  std::vector<int> poseCounts = {12, 24};
   std::uint64_t seed = 1;
   std::filesystem::path work;  // captures are rendered here (kept for inspection)
   std::function<void(const std::string&)> progress;
@@ -48,6 +50,7 @@ struct SceneDepth {
 
 struct CalibrationCase {
   std::string rig;
+  int poses = 0;
   std::string verdict;
   std::string failure;        // the solve's error; empty when it succeeded
   double cameraRmsPx = 0;     // largest over the cameras
@@ -72,7 +75,6 @@ void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std:
 [[nodiscard]] std::vector<CalibrationCase> runCalibrationEval(
     const CalibrationEvalOptions& options);
 [[nodiscard]] std::string calibrationMarkdown(const std::vector<CalibrationCase>& cases,
-                                              const CalibrationEvalOptions& options,
                                               const std::string& command);
 
 }  // namespace smx::host

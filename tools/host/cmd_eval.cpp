@@ -89,12 +89,13 @@ int runHealthEval(const EvalOptions& o, const CliStreams& io) {
 }
 
 // `--only calibration`: calibration on simulated captures against the real rig,
-// DIR/calibration-results.md (calibration_eval.hpp). Captures stay in DIR/calibration-work/.
+// DIR/calibration-results.md (calibration_eval.hpp). The captures stay in the system's temporary
+// folder, stripemux-calibration-eval/, for inspection.
 int runCalibrationEval(const EvalOptions& o, const CliStreams& io) {
   CalibrationEvalOptions options;
   options.scenes = o.scenes;
   options.seed = o.seed;
-  options.work = o.out / "calibration-work";
+  options.work = std::filesystem::temp_directory_path() / "stripemux-calibration-eval";
   options.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
   try {
     const auto cases = runCalibrationEval(options);
@@ -103,8 +104,8 @@ int runCalibrationEval(const EvalOptions& o, const CliStreams& io) {
       io.err << "stripemux eval: " << out.error() << '\n';
       return kExitDeviceOrIo;
     }
-    if (auto ok = out->writeText("calibration-results.md",
-                                 calibrationMarkdown(cases, options, commandLine(o)));
+    if (auto ok =
+            out->writeText("calibration-results.md", calibrationMarkdown(cases, commandLine(o)));
         !ok || !out->commit()) {
       io.err << "stripemux eval: cannot write " << (o.out / "calibration-results.md").string()
              << '\n';
