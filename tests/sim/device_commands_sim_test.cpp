@@ -157,8 +157,9 @@ TEST(DeviceCommandsSim, CheckOnADeviceFlagsAProjectorItsRigMisplaces) {
   EXPECT_EQ(json["summary"], "drifted: proj0 (recalibrate)");
 }
 
-// --device with --rig, or the offline form without --captures, is a usage error.
-TEST(DeviceCommandsSim, MixingTheFormsIsAUsageError) {
+// --device with --rig, the offline form without --captures, or a malformed address is a usage
+// error; a device that is not there is exit 3, and no RIG.json is written.
+TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
   const std::string rig = (kSource / "boards/sim/rig_2proj_1cam.json").string();
   EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--rig", rig, "--out", "x.json"}).code,
             host::kExitUsage);
@@ -168,6 +169,15 @@ TEST(DeviceCommandsSim, MixingTheFormsIsAUsageError) {
       host::kExitUsage);
   EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1", "--rig", rig}).code, host::kExitUsage);
   EXPECT_EQ(cli({"check", "--images", "frame"}).code, host::kExitUsage);
+  EXPECT_EQ(cli({"check", "--device", "10.0.0.2:99999"}).code, host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--device", "10.0.0.2:", "--out", "x.json"}).code, host::kExitUsage);
+
+  const fs::path out = scratch("nobody");
+  const auto nobody =
+      cli({"calibrate", "--device", "127.0.0.1:1", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(nobody.code, host::kExitDeviceOrIo) << nobody.err;
+  EXPECT_FALSE(fs::exists(out / "rig.json"));
+  EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1"}).code, host::kExitDeviceOrIo);
 }
 
 // `stripemux sim --calibration` scene, each pose held for `hold` frames, rendered at
