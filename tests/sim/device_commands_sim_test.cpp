@@ -158,7 +158,8 @@ TEST(DeviceCommandsSim, CheckOnADeviceFlagsAProjectorItsRigMisplaces) {
 }
 
 // --device with --rig, the offline form without --captures, or a malformed address is a usage
-// error; a device that is not there is exit 3, and no RIG.json is written.
+// error, as is a captures folder that holds an earlier session's poses; a device that is not
+// there is exit 3, and no RIG.json is written.
 TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
   const std::string rig = (kSource / "boards/sim/rig_2proj_1cam.json").string();
   EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--rig", rig, "--out", "x.json"}).code,
@@ -178,6 +179,14 @@ TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
   EXPECT_EQ(nobody.code, host::kExitDeviceOrIo) << nobody.err;
   EXPECT_FALSE(fs::exists(out / "rig.json"));
   EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1"}).code, host::kExitDeviceOrIo);
+
+  // Captures of an earlier session are not mixed with new ones.
+  fs::create_directories(out / "rig.captures/pose00");
+  const auto earlier =
+      cli({"calibrate", "--device", "127.0.0.1:1", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(earlier.code, host::kExitUsage);
+  EXPECT_NE(earlier.err.find("rig.captures already holds captures (pose00/)"), std::string::npos)
+      << earlier.err;
 }
 
 // `stripemux sim --calibration` scene, each pose held for `hold` frames, rendered at

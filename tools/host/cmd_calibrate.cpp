@@ -119,6 +119,13 @@ int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
   if (opts.captures.empty()) {
     opts.captures = defaultCaptures(opts.out);
   }
+  // Poses of an earlier session beside new ones would be solved as one rig.
+  std::error_code ec;
+  if (fs::exists(opts.captures / "pose00", ec)) {
+    return fail(io, kExitUsage,
+                opts.captures.string() +
+                    " already holds captures (pose00/): give another --captures or remove them");
+  }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
