@@ -174,16 +174,22 @@ TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
   EXPECT_EQ(cli({"calibrate", "--device", "10.0.0.2:", "--out", "x.json"}).code, host::kExitUsage);
 
   const fs::path out = scratch("nobody");
-  const auto nobody =
+  const auto noTarget =
       cli({"calibrate", "--device", "127.0.0.1:1", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(noTarget.code, host::kExitUsage);
+  EXPECT_NE(noTarget.err.find("no target: give --target COLSxROWS and --square M"),
+            std::string::npos)
+      << noTarget.err;
+  const auto nobody = cli({"calibrate", "--device", "127.0.0.1:1", "--target", "9x6", "--square",
+                           "0.03", "--out", (out / "rig.json").string()});
   EXPECT_EQ(nobody.code, host::kExitDeviceOrIo) << nobody.err;
   EXPECT_FALSE(fs::exists(out / "rig.json"));
   EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1"}).code, host::kExitDeviceOrIo);
 
   // Captures of an earlier session are not mixed with new ones.
   fs::create_directories(out / "rig.captures/pose00");
-  const auto earlier =
-      cli({"calibrate", "--device", "127.0.0.1:1", "--out", (out / "rig.json").string()});
+  const auto earlier = cli({"calibrate", "--device", "127.0.0.1:1", "--target", "9x6", "--square",
+                            "0.03", "--out", (out / "rig.json").string()});
   EXPECT_EQ(earlier.code, host::kExitUsage);
   EXPECT_NE(earlier.err.find("rig.captures already holds captures (pose00/)"), std::string::npos)
       << earlier.err;

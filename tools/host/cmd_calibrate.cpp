@@ -126,6 +126,11 @@ int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
                 opts.captures.string() +
                     " already holds captures (pose00/): give another --captures or remove them");
   }
+  if ((guide.cols == 0 || guide.squareM == 0) && !fs::exists(opts.captures / "target.json", ec)) {
+    return fail(io, kExitUsage,
+                "no target: give --target COLSxROWS and --square M, or write " +
+                    (opts.captures / "target.json").string());
+  }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
