@@ -296,6 +296,29 @@ std::expected<bool, std::string> capturePose(DeviceClient& device, const algo::R
 
 }  // namespace
 
+std::expected<std::pair<int, int>, std::string> parseInnerCorners(const std::string& text) {
+  const auto fail =
+      Fail("--target: expected COLSxROWS inner corners, e.g. 9x6, got \"" + printable(text) + "\"");
+  const auto x = text.find('x');
+  if (x == std::string::npos) {
+    return fail;
+  }
+  try {
+    std::size_t used = 0;
+    const int cols = std::stoi(text.substr(0, x), &used);
+    if (used != x) {
+      return fail;
+    }
+    const int rows = std::stoi(text.substr(x + 1), &used);
+    if (used != text.size() - x - 1) {
+      return fail;
+    }
+    return std::pair{cols, rows};
+  } catch (const std::exception&) {
+    return fail;
+  }
+}
+
 std::expected<CaptureSummary, std::string> captureCalibrationSet(DeviceClient& device,
                                                                  const algo::Rig& rig,
                                                                  const CaptureGuideOptions& options,

@@ -4,6 +4,7 @@
 #include <expected>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -48,6 +49,10 @@ struct CaptureSummary {
   int cellsHit = 0;  // coverage grid cells of the first camera holding a corner of some pose
   int cells = 0;
 };
+
+// "9x6" → {9, 6}: the --target option's inner corners COLSxROWS, or why not.
+[[nodiscard]] std::expected<std::pair<int, int>, std::string> parseInnerCorners(
+    const std::string& text);
 
 [[nodiscard]] std::expected<CaptureSummary, std::string> captureCalibrationSet(
     DeviceClient& device, const algo::Rig& rig, const CaptureGuideOptions& options,

@@ -1,12 +1,18 @@
 // stripemux calibrate --rig NOMINAL.json --captures DIR --out RIG.json [--report DIR]
-// A rig's cameras and projectors from captures of a printed target (docs/calibration.md). The
-// rig file is written only when the solve succeeds, and then whole or not at all.
+// stripemux calibrate --device HOST[:PORT] --poses N --out RIG.json [--captures DIR] [--report DIR]
+// A rig's cameras and projectors from captures of a printed target (docs/calibration.md), taken
+// beforehand or, with --device, by the guided capture first. The rig file is written only when
+// the solve succeeds, and then whole or not at all.
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 
+#include "calib_capture.hpp"
 #include "commands.hpp"
+#include "device_client.hpp"
+#include "device_option.hpp"
 #include "output_folder.hpp"
 #include "smx/calib/calibrate.hpp"
 #include "smx/calib/report.hpp"
@@ -22,6 +28,11 @@ struct CalibrateOptions {
   fs::path captures;
   fs::path out;
   std::optional<fs::path> report;
+  // The --device form: the guided capture into `captures` (default beside `out`) first.
+  std::string device;
+  int poses = 12;
+  std::string target;  // COLSxROWS inner corners
+  double squareM = 0;
 };
 
 int fail(const CliStreams& io, int code, const std::string& message) {
@@ -29,16 +40,13 @@ int fail(const CliStreams& io, int code, const std::string& message) {
   return code;
 }
 
-int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
-  const auto nominal = config::loadRig(opts.rig);
-  if (!nominal) {
-    return fail(io, kExitBadInput, nominal.error().message());
-  }
+// The solve and the writing of the rig and the report, shared by both forms.
+int solveAndWrite(const algo::Rig& nominal, const CalibrateOptions& opts, const CliStreams& io) {
   const fs::path outFile = opts.out.filename();
   if (const auto problem = fileNameProblem(outFile.string())) {
     return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
   }
-  auto calibration = calib::calibrate(*nominal, opts.captures);
+  auto calibration = calib::calibrate(nominal, opts.captures);
   if (!calibration) {
     return fail(io, kExitBadInput,
                 calibration.error() + " (" + opts.out.string() + " was not written)");
@@ -80,22 +88,103 @@ int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
+int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
+  const auto nominal = config::loadRig(opts.rig);
+  if (!nominal) {
+    return fail(io, kExitBadInput, nominal.error().message());
+  }
+  return solveAndWrite(*nominal, opts, io);
+}
+
+// RIG.json → RIG.captures beside it.
+fs::path defaultCaptures(const fs::path& out) {
+  return out.parent_path() / (out.stem().string() + ".captures");
+}
+
+int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
+  // What can be checked without the device is, before connecting.
+  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
+    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  }
+  CaptureGuideOptions guide;
+  guide.poses = opts.poses;
+  guide.squareM = opts.squareM;
+  if (!opts.target.empty()) {
+    const auto corners = parseInnerCorners(opts.target);
+    if (!corners) {
+      return fail(io, kExitUsage, corners.error());
+    }
+    std::tie(guide.cols, guide.rows) = *corners;
+  }
+  if (opts.captures.empty()) {
+    opts.captures = defaultCaptures(opts.out);
+  }
+  // Poses of an earlier session beside new ones would be solved as one rig.
+  std::error_code ec;
+  if (fs::exists(opts.captures / "pose00", ec)) {
+    return fail(io, kExitUsage,
+                opts.captures.string() +
+                    " already holds captures (pose00/): give another --captures or remove them");
+  }
+  if ((guide.cols == 0 || guide.squareM == 0) && !fs::exists(opts.captures / "target.json", ec)) {
+    return fail(io, kExitUsage,
+                "no target: give --target COLSxROWS and --square M, or write " +
+                    (opts.captures / "target.json").string());
+  }
+  auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
+  if (!client) {
+    return fail(io, kExitDeviceOrIo, client.error());
+  }
+  const algo::Rig nominal = client->info().rig;
+  const auto captured = captureCalibrationSet(*client, nominal, guide, opts.captures, io);
+  client->close();
+  if (!captured) {
+    return fail(io, kExitDeviceOrIo, captured.error());
+  }
+  return solveAndWrite(nominal, opts, io);
+}
+
 }  // namespace
 
 void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<CalibrateOptions>();
   auto* cmd = app.add_subcommand(
       "calibrate", "A rig's cameras and projectors from captures of a printed target");
-  cmd->add_option("--rig", opts->rig,
-                  "The rig as designed (stripemux-rig/1): ids, sizes, "
-                  "patterns and rough poses")
-      ->required();
-  cmd->add_option("--captures", opts->captures,
-                  "Folder of target.json and pose00/, pose01/, … (docs/calibration.md)")
-      ->required();
+  auto* rig = cmd->add_option("--rig", opts->rig,
+                              "The rig as designed (stripemux-rig/1): ids, sizes, "
+                              "patterns and rough poses");
+  auto* captures =
+      cmd->add_option("--captures", opts->captures,
+                      "Folder of target.json and pose00/, pose01/, … (docs/calibration.md); "
+                      "with --device, where the guided capture writes them (default RIG.captures "
+                      "beside --out)");
   cmd->add_option("--out", opts->out, "The calibrated rig.json to write")->required();
   cmd->add_option("--report", opts->report, "Folder for report.json and summary.txt");
-  cmd->callback([opts, &io, &exitCode] { exitCode = runCalibrate(*opts, io); });
+  auto* device = cmd->add_option(
+      "--device", opts->device,
+      "HOST[:PORT] of a device: capture the poses there (guided), then solve with its rig");
+  device->check(deviceAddressValidator())->excludes(rig);
+  cmd->add_option("--poses", opts->poses, "With --device: poses to capture (default 12)")
+      ->check(CLI::Range(1, 100))
+      ->needs(device);
+  cmd->add_option("--target", opts->target,
+                  "With --device: the checkerboard's inner corners COLSxROWS, e.g. 9x6 (else "
+                  "<captures>/target.json)")
+      ->needs(device);
+  cmd->add_option("--square", opts->squareM, "With --device: the checkerboard's square, metres")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->needs(device);
+  cmd->callback([opts, device, rig, captures, &io, &exitCode] {
+    if (device->count() > 0) {
+      exitCode = runDeviceCalibrate(*opts, io);
+    } else if (rig->count() == 0 || captures->count() == 0) {
+      exitCode = fail(io, kExitUsage,
+                      "give --rig and --captures (captures taken before), or --device (capture "
+                      "there first)");
+    } else {
+      exitCode = runCalibrate(*opts, io);
+    }
+  });
 }
 
 }  // namespace smx::host

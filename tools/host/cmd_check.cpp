@@ -1,7 +1,8 @@
 // stripemux check --rig RIG.json --images DIR [--report DIR2] [--json]
+// stripemux check --device HOST[:PORT] [--report DIR2] [--json]
 // The rig's health check on one frame with every projector lit: DIR/<cam>.png per camera (as
-// `stripemux sim` writes them); per projector a verdict, good / drifted / not enough overlap
-// (docs/health-check.md, docs/cli.md).
+// `stripemux sim` writes them) or a raw capture from the device, checked with its rig; per
+// projector a verdict, good / drifted / not enough overlap (docs/health-check.md, docs/cli.md).
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,8 @@
 
 #include "camera_images.hpp"
 #include "commands.hpp"
+#include "device_client.hpp"
+#include "device_option.hpp"
 #include "output_folder.hpp"
 #include "smx/health/check.hpp"
 
@@ -24,9 +27,13 @@ using Json = nlohmann::ordered_json;
 // The check ran and a projector is not good (docs/cli.md).
 constexpr int kExitNotHealthy = 4;
 
+// How long the device may take for the raw capture.
+constexpr auto kCaptureTimeout = std::chrono::milliseconds(10'000);
+
 struct CheckOptions {
   fs::path rig;
   fs::path images;
+  std::string device;
   std::optional<fs::path> report;
   bool json = false;
 };
@@ -94,15 +101,45 @@ std::string toText(const health::CheckReport& report) {
   return s.str();
 }
 
+int fail(const CliStreams& io, int code, const std::string& message) {
+  io.err << "stripemux check: " << message << "\n";
+  return code;
+}
+
+// The check of `frames` with `rig` (named `rigName` in errors), printed and written.
+int checkAndReport(const algo::Rig& rig, const std::string& rigName,
+                   const std::vector<health::CameraFrame>& frames, const CheckOptions& opts,
+                   const CliStreams& io) {
+  const auto report = health::checkRig(rig, frames);
+  if (!report) {
+    return fail(io, kExitBadInput, rigName + ": " + report.error());
+  }
+  const Json json = toJson(rig, *report);
+  const std::string jsonText = json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+  if (opts.report) {
+    auto out = OutputFolder::create(*opts.report);
+    if (!out) {
+      return fail(io, kExitDeviceOrIo, out.error());
+    }
+    if (auto ok = out->writeText("check.json", jsonText); !ok) {
+      return fail(io, kExitDeviceOrIo, ok.error());
+    }
+    if (auto ok = out->writeText("check.txt", toText(*report)); !ok) {
+      return fail(io, kExitDeviceOrIo, ok.error());
+    }
+    if (auto ok = out->commit(); !ok) {
+      return fail(io, kExitDeviceOrIo, ok.error());
+    }
+  }
+  io.out << (opts.json ? jsonText : toText(*report));
+  return report->healthy ? kExitOk : kExitNotHealthy;
+}
+
 int runCheck(const CheckOptions& opts, const CliStreams& io) {
-  const auto fail = [&](int code, const std::string& message) {
-    io.err << "stripemux check: " << message << "\n";
-    return code;
-  };
   // One image per camera that has one in the folder; loadRigAndImages checks the rig and them.
   auto rigOnly = loadRigAndImages(opts.rig, {});
   if (!rigOnly) {
-    return fail(kExitBadInput, rigOnly.error());
+    return fail(io, kExitBadInput, rigOnly.error());
   }
   std::vector<std::string> specs;
   for (const auto& camera : rigOnly->rig.cameras) {
@@ -113,21 +150,22 @@ int runCheck(const CheckOptions& opts, const CliStreams& io) {
     }
   }
   if (specs.empty()) {
-    return fail(kExitBadInput, opts.images.string() + ": no camera image (expected " +
-                                   rigOnly->rig.cameras.front().id + ".png and one per camera)");
+    return fail(io, kExitBadInput,
+                opts.images.string() + ": no camera image (expected " +
+                    rigOnly->rig.cameras.front().id + ".png and one per camera)");
   }
   const auto loaded = loadRigAndImages(opts.rig, specs);
   if (!loaded) {
-    return fail(kExitBadInput, loaded.error());
+    return fail(io, kExitBadInput, loaded.error());
   }
   std::vector<sim::RgbImage> images;
   for (const CameraImage& input : loaded->images) {
     auto image = readCameraImage(input.file, loaded->rig.cameras[input.camera]);
     if (!image) {
-      return fail(kExitBadInput, image.error());
+      return fail(io, kExitBadInput, image.error());
     }
     if (auto colour = checkHasColour(input.file, *image); !colour) {
-      return fail(kExitBadInput, colour.error());
+      return fail(io, kExitBadInput, colour.error());
     }
     images.push_back(std::move(*image));
   }
@@ -135,29 +173,41 @@ int runCheck(const CheckOptions& opts, const CliStreams& io) {
   for (std::size_t i = 0; i < images.size(); ++i) {
     frames.push_back({loaded->images[i].camera, images[i].view()});
   }
-  const auto report = health::checkRig(loaded->rig, frames);
-  if (!report) {
-    return fail(kExitBadInput, opts.rig.string() + ": " + report.error());
+  return checkAndReport(loaded->rig, opts.rig.string(), frames, opts, io);
+}
+
+// One raw capture with every projector lit, checked with the rig the device announces.
+int runDeviceCheck(const CheckOptions& opts, const CliStreams& io) {
+  auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
+  if (!client) {
+    return fail(io, kExitDeviceOrIo, client.error());
   }
-  const Json json = toJson(loaded->rig, *report);
-  const std::string jsonText = json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
-  if (opts.report) {
-    auto out = OutputFolder::create(*opts.report);
-    if (!out) {
-      return fail(kExitDeviceOrIo, out.error());
-    }
-    if (auto ok = out->writeText("check.json", jsonText); !ok) {
-      return fail(kExitDeviceOrIo, ok.error());
-    }
-    if (auto ok = out->writeText("check.txt", toText(*report)); !ok) {
-      return fail(kExitDeviceOrIo, ok.error());
-    }
-    if (auto ok = out->commit(); !ok) {
-      return fail(kExitDeviceOrIo, ok.error());
-    }
+  const algo::Rig& rig = client->info().rig;
+  const std::string rigName = client->info().address + ": the device's rig";
+  if (rig.cameras.empty() || rig.projectors.empty() || rig.projectors.size() > 32) {
+    return fail(io, kExitBadInput, rigName + ": the check needs a camera and 1 to 32 projectors");
   }
-  io.out << (opts.json ? jsonText : toText(*report));
-  return report->healthy ? kExitOk : kExitNotHealthy;
+  const std::uint32_t all = rig.projectors.size() == 32 ? ~0U : (1U << rig.projectors.size()) - 1U;
+  const auto capture = client->captureRaw(all, kCaptureTimeout);
+  client->close();
+  if (!capture) {
+    return fail(io, kExitDeviceOrIo, client->info().address + ": " + capture.error());
+  }
+  std::vector<health::CameraFrame> frames;
+  for (std::size_t c = 0; c < rig.cameras.size() && c < capture->images.size(); ++c) {
+    const auto& camera = rig.cameras[c];
+    const auto view =
+        algo::ConstRgbView::packed(capture->images[c], capture->width, capture->height);
+    if (!view || capture->width != camera.width || capture->height != camera.height) {
+      return fail(io, kExitDeviceOrIo,
+                  client->info().address + ": " + camera.id + " sent " +
+                      std::to_string(capture->width) + "x" + std::to_string(capture->height) +
+                      ", its rig says " + std::to_string(camera.width) + "x" +
+                      std::to_string(camera.height));
+    }
+    frames.push_back({c, *view});
+  }
+  return checkAndReport(rig, rigName, frames, opts, io);
 }
 
 }  // namespace
@@ -166,13 +216,25 @@ void addCheckCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<CheckOptions>();
   auto* cmd = app.add_subcommand(
       "check", "Health check: do the projectors' depths agree where they overlap? (one frame)");
-  cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)")->required();
-  cmd->add_option("--images", opts->images,
-                  "Folder with one frame's camera images, all projectors lit: <camera id>.png")
-      ->required();
+  auto* rig = cmd->add_option("--rig", opts->rig, "Rig description (stripemux-rig/1 JSON)");
+  auto* images =
+      cmd->add_option("--images", opts->images,
+                      "Folder with one frame's camera images, all projectors lit: <camera id>.png");
+  auto* device = cmd->add_option(
+      "--device", opts->device,
+      "HOST[:PORT] of a device: one raw capture with every projector lit, checked with its rig");
+  device->check(deviceAddressValidator())->excludes(rig)->excludes(images);
   cmd->add_option("--report", opts->report, "Folder for check.json and check.txt");
   cmd->add_flag("--json", opts->json, "Print the report as JSON (stripemux-check/1)");
-  cmd->callback([opts, &io, &exitCode] { exitCode = runCheck(*opts, io); });
+  cmd->callback([opts, device, rig, images, &io, &exitCode] {
+    if (device->count() > 0) {
+      exitCode = runDeviceCheck(*opts, io);
+    } else if (rig->count() == 0 || images->count() == 0) {
+      exitCode = fail(io, kExitUsage, "give --rig and --images, or --device");
+    } else {
+      exitCode = runCheck(*opts, io);
+    }
+  });
 }
 
 }  // namespace smx::host

@@ -1,0 +1,258 @@
+// `stripemux check --device` and `stripemux calibrate --device` against the simulated board
+// (label "sim"). The board renders with the true rig and announces another (the rig.json it was
+// given), as a rig that drifted since its calibration does: the check must flag the difference,
+// and the calibration must find the true rig from the announced one.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.hpp"
+#include "smx/config/board_json.hpp"
+#include "smx/config/rig_json.hpp"
+#include "smx/device/device.hpp"
+#include "smx/hal/board_hal.hpp"
+#include "source_dir.hpp"
+
+namespace smx {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using Json = nlohmann::json;
+
+const fs::path kSource = test::sourceDir();
+
+struct CliRun {
+  int code;
+  std::string out;
+  std::string err;
+};
+
+CliRun cli(const std::vector<std::string>& args) {
+  std::ostringstream out;
+  std::ostringstream err;
+  const int code = host::runCli(args, {out, err});
+  return {code, out.str(), err.str()};
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("smx_device_commands_sim_test_" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+// boards/sim rendering `scene` with `rendered`, announcing `announced`, on a free loopback port.
+// Only raw captures are served (no range stream), so the simulated camera's frame k is the k-th
+// raw capture: a scene's pose_sequence advances one frame per capture.
+class SimDevice {
+ public:
+  SimDevice(const std::string& scene, const algo::Rig& rendered, const algo::Rig& announced) {
+    board_ = config::loadBoard(kSource / "boards/sim").value();
+    board_.config.sim.scene = scene;
+    board_.config.sim.replayDir.clear();
+    board_.config.network.port = 0;
+    board_.config.cameras.resize(announced.cameras.size());
+    for (auto& camera : board_.config.cameras) {
+      camera.format.fps = 1000;
+    }
+    board_.rig = announced;
+    auto made = hal::createBoardHal(board_.config, rendered);
+    EXPECT_TRUE(made.has_value()) << made.error();
+    boardHal_ = std::move(*made);
+    auto dev = device::Device::create(board_, boardHal_->hal(), {});
+    EXPECT_TRUE(dev.has_value()) << dev.error();
+    device_ = std::move(*dev);
+    network_ = std::jthread([this] { device_->runNetwork(stopNetwork_); });
+    raw_ = std::jthread([this](const std::stop_token& stop) {
+      while (!stop.stop_requested()) {
+        if (!device_->serveRawCapture()) {
+          std::this_thread::sleep_for(1ms);
+        }
+      }
+    });
+  }
+  ~SimDevice() {
+    raw_.request_stop();
+    raw_.join();
+    stopNetwork_ = true;
+  }
+  SimDevice(const SimDevice&) = delete;
+  SimDevice& operator=(const SimDevice&) = delete;
+
+  [[nodiscard]] std::string address() const {
+    return "127.0.0.1:" + std::to_string(boardHal_->hal().link.port());
+  }
+
+ private:
+  config::Board board_;
+  std::unique_ptr<hal::BoardHal> boardHal_;
+  std::unique_ptr<device::Device> device_;
+  std::atomic<bool> stopNetwork_ = false;
+  std::jthread network_;
+  std::jthread raw_;
+};
+
+algo::Rig loadRig(const fs::path& file) {
+  auto rig = config::loadRig(file);
+  EXPECT_TRUE(rig.has_value()) << file;
+  return rig.value_or(algo::Rig{});
+}
+
+// The projector's centre in the world frame, C = -Rᵀ·t.
+std::array<double, 3> centre(const algo::DeviceModel& d) {
+  std::array<double, 3> c{};
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      c[static_cast<std::size_t>(i)] -=
+          d.R[static_cast<std::size_t>(k * 3 + i)] * d.t[static_cast<std::size_t>(k)];
+    }
+  }
+  return c;
+}
+
+double distanceMm(const algo::DeviceModel& a, const algo::DeviceModel& b) {
+  const auto ca = centre(a);
+  const auto cb = centre(b);
+  return 1000 * std::hypot(ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]);
+}
+
+// `rig` with the projector moved by `metres` along its own x (axis 0) or y (axis 1). Across its
+// stripes, so that the move shows: along them it leaves every stripe plane where it was.
+algo::Rig withProjectorMoved(algo::Rig rig, std::size_t projector, std::size_t axis,
+                             double metres) {
+  rig.projectors[projector].t.at(axis) -= metres;
+  return rig;
+}
+
+// Given a device rendering a plane with the rig it announces, `check --device` calls every
+// projector good (exit 0); given one whose announced rig has proj0 2 mm off where it is
+// rendered, the check names proj0 as drifted (exit 4). Two cameras, so the projector is named.
+TEST(DeviceCommandsSim, CheckOnADeviceFlagsAProjectorItsRigMisplaces) {
+  const algo::Rig truth = loadRig(kSource / "boards/sim/rig_2proj_2cam.json");
+  {
+    const SimDevice device("plane", truth, truth);
+    const fs::path report = scratch("check_good");
+    const auto run = cli({"check", "--device", device.address(), "--report", report.string()});
+    EXPECT_EQ(run.code, host::kExitOk) << run.err << run.out;
+    EXPECT_NE(run.out.find("good: all 2 projectors agree"), std::string::npos) << run.out;
+    EXPECT_TRUE(fs::exists(report / "check.json"));
+  }
+  const SimDevice device("plane", truth, withProjectorMoved(truth, 0, 0, 0.002));
+  const auto run = cli({"check", "--device", device.address(), "--json"});
+  EXPECT_EQ(run.code, 4) << run.err << run.out;
+  const auto json = Json::parse(run.out, nullptr, false);
+  ASSERT_FALSE(json.is_discarded()) << run.out;
+  EXPECT_FALSE(json["healthy"].get<bool>());
+  EXPECT_EQ(json["projectors"][0]["verdict"], "drifted");
+  EXPECT_EQ(json["projectors"][1]["verdict"], "good");
+  EXPECT_EQ(json["summary"], "drifted: proj0 (recalibrate)");
+}
+
+// --device with --rig, the offline form without --captures, or a malformed address is a usage
+// error, as is a captures folder that holds an earlier session's poses; a device that is not
+// there is exit 3, and no RIG.json is written.
+TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
+  const std::string rig = (kSource / "boards/sim/rig_2proj_1cam.json").string();
+  EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--rig", rig, "--out", "x.json"}).code,
+            host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--rig", rig, "--out", "x.json"}).code, host::kExitUsage);
+  EXPECT_EQ(
+      cli({"calibrate", "--rig", rig, "--captures", "c", "--poses", "6", "--out", "x.json"}).code,
+      host::kExitUsage);
+  EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1", "--rig", rig}).code, host::kExitUsage);
+  EXPECT_EQ(cli({"check", "--images", "frame"}).code, host::kExitUsage);
+  EXPECT_EQ(cli({"check", "--device", "10.0.0.2:99999"}).code, host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--device", "10.0.0.2:", "--out", "x.json"}).code, host::kExitUsage);
+
+  const fs::path out = scratch("nobody");
+  const auto noTarget =
+      cli({"calibrate", "--device", "127.0.0.1:1", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(noTarget.code, host::kExitUsage);
+  EXPECT_NE(noTarget.err.find("no target: give --target COLSxROWS and --square M"),
+            std::string::npos)
+      << noTarget.err;
+  const auto nobody = cli({"calibrate", "--device", "127.0.0.1:1", "--target", "9x6", "--square",
+                           "0.03", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(nobody.code, host::kExitDeviceOrIo) << nobody.err;
+  EXPECT_FALSE(fs::exists(out / "rig.json"));
+  EXPECT_EQ(cli({"check", "--device", "127.0.0.1:1"}).code, host::kExitDeviceOrIo);
+
+  // Captures of an earlier session are not mixed with new ones.
+  fs::create_directories(out / "rig.captures/pose00");
+  const auto earlier = cli({"calibrate", "--device", "127.0.0.1:1", "--target", "9x6", "--square",
+                            "0.03", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(earlier.code, host::kExitUsage);
+  EXPECT_NE(earlier.err.find("rig.captures already holds captures (pose00/)"), std::string::npos)
+      << earlier.err;
+}
+
+// `stripemux sim --calibration` scene, each pose held for `hold` frames, rendered at
+// `supersampling`: fewer frames per pose and samples per pixel keep the test short; the guided
+// capture needs 5 frames of a pose (two still off frames, one per projector, the off frame again).
+fs::path quickCalibrationScene(const fs::path& simOut, int hold, int supersampling) {
+  std::ifstream in(simOut / "truth/scene.json");
+  Json scene = Json::parse(in);
+  scene["supersampling"] = supersampling;
+  for (auto& object : scene["objects"]) {
+    if (object.contains("pose_sequence")) {
+      object["pose_sequence"]["hold_frames"] = hold;
+    }
+  }
+  const fs::path file = simOut / "truth/quick_scene.json";
+  std::ofstream(file) << scene.dump(2);
+  return file;
+}
+
+// Given a device playing a person placing the target in turn (a `stripemux sim --calibration`
+// scene) with the true rig, announcing a rig whose proj1 is 6 mm off, `calibrate --device
+// --poses 6` captures six poses into RIG.captures beside --out and solves: proj1 lands near
+// where the board renders it (truth/rig.json), far nearer than the announced rig has it.
+TEST(DeviceCommandsSim, GuidedCalibrateOnADeviceFindsTheRenderedRig) {
+  const fs::path nominalFile = kSource / "boards/sim/rig_2proj_1cam.json";
+  const fs::path sim = scratch("calibration_sim");
+  const auto rendered =
+      cli({"sim", "--rig", nominalFile.string(), "--calibration", "8", "--out", sim.string()});
+  ASSERT_EQ(rendered.code, 0) << rendered.err;
+  const algo::Rig truth = loadRig(sim / "truth/rig.json");
+  const algo::Rig announced = withProjectorMoved(truth, 1, 1, 0.006);
+  std::ifstream targetIn(sim / "target.json");
+  const Json target = Json::parse(targetIn);
+  const std::string corners = std::to_string(target["inner_corners"][0].get<int>()) + "x" +
+                              std::to_string(target["inner_corners"][1].get<int>());
+
+  const SimDevice device(quickCalibrationScene(sim, 6, 1).string(), truth, announced);
+  const fs::path out = scratch("calibrated");
+  const auto run =
+      cli({"calibrate", "--device", device.address(), "--poses", "6", "--target", corners,
+           "--square", std::to_string(target["square_m"].get<double>()), "--out",
+           (out / "rig.json").string(), "--report", (out / "report").string()});
+  ASSERT_EQ(run.code, host::kExitOk) << run.err << "\n" << run.out;
+
+  EXPECT_NE(run.out.find("pose05: captured"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("wrote " + (out / "rig.json").string()), std::string::npos) << run.out;
+  for (const char* file : {"target.json", "pose00/cam0.png", "pose05/proj1.cam0.png"}) {
+    EXPECT_TRUE(fs::exists(out / "rig.captures" / file)) << file;
+  }
+  EXPECT_TRUE(fs::exists(out / "report/summary.txt"));
+
+  const algo::Rig solved = loadRig(out / "rig.json");
+  ASSERT_EQ(solved.projectors.size(), 2U);
+  EXPECT_NEAR(solved.cameras[0].fx(), truth.cameras[0].fx(), 4.0);
+  // proj1 from 6 mm off to within 1.5 mm; proj0, announced where it is, stays near. Along a
+  // projector's stripes its place is seen only through the target poses, hence the looser bound.
+  EXPECT_GT(distanceMm(announced.projectors[1], truth.projectors[1]), 5.9);
+  EXPECT_LT(distanceMm(solved.projectors[1], truth.projectors[1]), 1.5);
+  EXPECT_LT(distanceMm(solved.projectors[0], truth.projectors[0]), 3.0);
+}
+
+}  // namespace
+}  // namespace smx

@@ -1,0 +1,24 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <string>
+
+#include "smx/net/tcp_client.hpp"
+#include "smx/protocol/wire.hpp"
+
+// The --device HOST[:PORT] option of the commands that talk to a device.
+namespace smx::host {
+
+inline constexpr auto kDeviceConnectTimeout = std::chrono::milliseconds(3000);
+
+// A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
+inline CLI::Validator deviceAddressValidator() {
+  return {[](const std::string& text) {
+            const auto parsed = net::parseDeviceAddress(text, protocol::kDefaultPort);
+            return parsed ? std::string() : parsed.error();
+          },
+          "HOST[:PORT]"};
+}
+
+}  // namespace smx::host
