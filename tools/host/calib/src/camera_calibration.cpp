@@ -231,9 +231,10 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
       } else if (auto image = sim::readPngRgb8(
                      file, sim::PngSizeLimit::exactly(cam.width, cam.height, "camera " + cam.id));
                  !image) {
-        return std::unexpected(image.error());
+        return std::unexpected(set.poses[p].name + ": " + image.error() +
+                               ": capture this pose again or remove its folder");
       } else if (auto corners = findTargetCorners(set.target, image->view()); corners.empty()) {
-        use.note = "target not found (not wholly in view, too dark or blurred)";
+        use.note = "target not found (not wholly in view, too dark or blurred): not used";
       } else {
         View v{.pose = p, .corners = {}};
         for (const auto& q : corners) {
@@ -244,13 +245,20 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
       fit.poses.push_back(std::move(use));
     }
     const auto tooFew = [&] {
-      std::string found;
+      std::string used;
       for (const View& v : views) {
-        found += (found.empty() ? "" : ", ") + set.poses[v.pose].name;
+        used += (used.empty() ? "" : ", ") + set.poses[v.pose].name;
       }
-      return cam.id + ": the target was found in " + std::to_string(views.size()) + " poses (" +
-             (found.empty() ? "none" : found) + "); at least " + std::to_string(kMinPoses) +
-             " are needed: capture more with the whole board in " + cam.id + "'s view";
+      std::string dropped;
+      for (const PoseUse& use : fit.poses) {
+        if (!use.note.empty()) {
+          dropped += "; " + use.pose + ": " + use.note;
+        }
+      }
+      return cam.id + ": the target is usable in " + std::to_string(views.size()) + " poses (" +
+             (used.empty() ? "none" : used) + "), at least " + std::to_string(kMinPoses) +
+             " are needed: capture more with the whole board sharp in " + cam.id + "'s view" +
+             dropped;
     };
     if (static_cast<int>(views.size()) < kMinPoses) {
       return std::unexpected(tooFew());

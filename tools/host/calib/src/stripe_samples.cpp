@@ -125,15 +125,19 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
       if (files.lit[projector][c].empty() || files.off[c].empty()) {
         continue;  // the capture set's notes name the missing file
       }
-      const auto limit =
-          sim::PngSizeLimit::exactly(camera.width, camera.height, "camera " + camera.id);
+      const std::string owner = "camera " + camera.id;  // outlives the limit's view of it
+      const auto limit = sim::PngSizeLimit::exactly(camera.width, camera.height, owner);
+      const auto unreadable = [&](const std::string& error) {
+        return std::unexpected(files.name + ": " + error +
+                               ": capture this pose again or remove its folder");
+      };
       auto lit = sim::readPngRgb8(files.lit[projector][c], limit);
       if (!lit) {
-        return std::unexpected(lit.error());
+        return unreadable(lit.error());
       }
       auto off = sim::readPngRgb8(files.off[c], limit);
       if (!off) {
-        return std::unexpected(off.error());
+        return unreadable(off.error());
       }
       const Eigen::Vector3d middle =
           pose.R * Eigen::Vector3d((target.cols - 1) * target.squareM / 2,
@@ -180,6 +184,11 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
         }
       }
     }
+  }
+  if (samples.empty()) {
+    return std::unexpected(proj.id + ": no stripe decoded on the target in any pose (its frames " +
+                           "look unlit): is " + proj.id + " on in its frames and aimed at the " +
+                           "target?");
   }
   return samples;
 }
