@@ -46,9 +46,9 @@ int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
     return fail(io, kExitBadInput, calibration.error() + untouched);
   }
   if (auto valid = config::validateRig(calibration->rig); !valid) {
-    return fail(io, kExitBadInput,
-                "the solve failed: the solved rig is not valid: " + valid.error().message() +
-                    untouched);
+    return fail(
+        io, kExitBadInput,
+        "the solve failed: the solved rig is not valid: " + valid.error().message() + untouched);
   }
   const std::string text = calib::reportText(*calibration);
   auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");

@@ -41,9 +41,9 @@ std::expected<void, std::string> presentSomewhere(const std::vector<PoseFiles>& 
   if (std::ranges::any_of(poses, [&](const PoseFiles& p) { return !pick(p).empty(); })) {
     return {};
   }
-  return std::unexpected(device + ": " + file + " is missing in every pose (" +
-                         poses.front().name + " … " + poses.back().name + "): capture each pose " +
-                         "with " + device + " again, or leave " + device + " out of --rig");
+  return std::unexpected(device + ": " + file + " is missing in every pose (" + poses.front().name +
+                         " … " + poses.back().name + "): capture each pose " + "with " + device +
+                         " again, or leave " + device + " out of --rig");
 }
 
 // Two poses with byte-identical frames are one pose copied: real exposures always differ.
@@ -88,10 +88,10 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
     return std::unexpected(dir.string() + ": cannot list the folder: " + ec.message());
   }
   if (std::cmp_less(names.size(), kMinPoses)) {
-    return std::unexpected(dir.string() + ": " + std::to_string(names.size()) +
-                           " pose folders (pose00, pose01, …); at least " +
-                           std::to_string(kMinPoses) +
-                           " are needed: capture more poses, the target tilted differently in each");
+    return std::unexpected(
+        dir.string() + ": " + std::to_string(names.size()) +
+        " pose folders (pose00, pose01, …); at least " + std::to_string(kMinPoses) +
+        " are needed: capture more poses, the target tilted differently in each");
   }
   std::ranges::sort(names);
   for (const std::string& name : names) {
