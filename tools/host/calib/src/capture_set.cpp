@@ -116,7 +116,9 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
                                [c](const PoseFiles& p) -> const fs::path& { return p.off[c]; });
     for (std::size_t j = 0; ok && j < rig.projectors.size(); ++j) {
       const std::string& proj = rig.projectors[j].id;
-      ok = presentSomewhere(set.poses, proj, proj + "." + cam + ".png",
+      std::string file = proj;
+      file.append(".").append(cam).append(".png");
+      ok = presentSomewhere(set.poses, proj, file,
                             [c, j](const PoseFiles& p) -> const fs::path& { return p.lit[j][c]; });
     }
     if (!ok) {
