@@ -46,13 +46,17 @@ int solveAndWrite(const algo::Rig& nominal, const CalibrateOptions& opts, const 
   if (const auto problem = fileNameProblem(outFile.string())) {
     return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
   }
+  // A failed solve leaves an earlier rig and report as they were.
+  const std::string untouched = "; nothing written (" + opts.out.string() +
+                                (opts.report ? ", " + opts.report->string() : "") + ")";
   auto calibration = calib::calibrate(nominal, opts.captures);
   if (!calibration) {
-    return fail(io, kExitBadInput,
-                calibration.error() + " (" + opts.out.string() + " was not written)");
+    return fail(io, kExitBadInput, calibration.error() + untouched);
   }
   if (auto valid = config::validateRig(calibration->rig); !valid) {
-    return fail(io, kExitBadInput, "the solved rig is not valid: " + valid.error().message());
+    return fail(
+        io, kExitBadInput,
+        "the solve failed: the solved rig is not valid: " + valid.error().message() + untouched);
   }
   const std::string text = calib::reportText(*calibration);
   auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");

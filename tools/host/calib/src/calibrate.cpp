@@ -14,6 +14,16 @@ std::string px(double v) {
   return buf;
 }
 
+std::expected<void, std::string> checkSolved(const ProjectorFit& fit) {
+  if (fit.rmsPx <= kFailProjectorRmsPx) {
+    return {};
+  }
+  return std::unexpected(fit.projector.id + ": the solve failed: its stripes fit to " +
+                         px(fit.rmsPx) + ", far above the " + px(kGoodProjectorRmsPx) +
+                         " of a good set (projector moved between poses, or frames of another "
+                         "projector?): capture the set again");
+}
+
 }  // namespace
 
 std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
@@ -39,6 +49,9 @@ std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
     if (!fit) {
       return std::unexpected(fit.error());
     }
+    if (auto solved = checkSolved(*fit); !solved) {
+      return std::unexpected(solved.error());
+    }
     samples.push_back(std::move(*decoded));
     out.projectors.push_back(std::move(*fit));
   }
@@ -47,6 +60,11 @@ std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
     return std::unexpected(joint.error());
   }
   out.joint = *joint;
+  for (const ProjectorFit& fit : out.projectors) {
+    if (auto solved = checkSolved(fit); !solved) {
+      return std::unexpected(solved.error());
+    }
+  }
   for (const CameraFit& fit : cameras->cameras) {
     out.rig.cameras.push_back(fit.camera);
   }

@@ -89,8 +89,9 @@ struct Intrinsics {
 
 Intrinsics solveIntrinsics(const std::vector<View>& views, const Target& target,
                            const algo::Camera& nominal, int flags) {
-  std::vector<std::vector<cv::Point3f>> object(views.size(), objectPoints(target));
+  const std::vector<std::vector<cv::Point3f>> object(views.size(), objectPoints(target));
   std::vector<std::vector<cv::Point2f>> image;
+  image.reserve(views.size());
   for (const View& v : views) {
     image.push_back(v.corners);
   }
@@ -117,10 +118,10 @@ Intrinsics solveIntrinsics(const std::vector<View>& views, const Target& target,
 }
 
 Eigen::Matrix3d rotation(const cv::Mat& rvec) {
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
+  cv::Mat matrix;
+  cv::Rodrigues(rvec, matrix);
   Eigen::Matrix3d out;
-  cv::cv2eigen(R, out);
+  cv::cv2eigen(matrix, out);
   return out;
 }
 
@@ -147,8 +148,7 @@ std::expected<void, std::string> checkPoseSpread(std::vector<View>& views, const
   std::vector<Eigen::Vector3d> centres;
   std::vector<View> kept;
   for (std::size_t i = 0; i < views.size(); ++i) {
-    const Eigen::Matrix3d R = rotation(first.rvecs[i]);
-    const Eigen::Vector3d n = R.col(2);
+    const Eigen::Vector3d n = rotation(first.rvecs[i]).col(2);
     const Eigen::Vector3d c = vector3(first.tvecs[i]);
     bool repeat = false;
     for (std::size_t j = 0; j < normals.size() && !repeat; ++j) {
@@ -188,7 +188,8 @@ std::vector<std::array<double, 2>> findTargetCorners(const Target& target,
   const bool found =
       cv::findChessboardCorners(g, cv::Size(target.cols, target.rows), corners,
                                 cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
-  if (!found || corners.size() != static_cast<std::size_t>(target.cols * target.rows)) {
+  if (!found || corners.size() !=
+                    static_cast<std::size_t>(target.cols) * static_cast<std::size_t>(target.rows)) {
     return {};
   }
   // The refinement window stays inside the squares around each corner: a quarter of the
@@ -196,7 +197,8 @@ std::vector<std::array<double, 2>> findTargetCorners(const Target& target,
   double spacing = std::numeric_limits<double>::max();
   for (int r = 0; r < target.rows; ++r) {
     for (int c = 0; c + 1 < target.cols; ++c) {
-      const auto i = static_cast<std::size_t>(r * target.cols + c);
+      const auto i = (static_cast<std::size_t>(r) * static_cast<std::size_t>(target.cols)) +
+                     static_cast<std::size_t>(c);
       spacing = std::min<double>(spacing, cv::norm(corners[i + 1] - corners[i]));
     }
   }
@@ -231,9 +233,10 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
       } else if (auto image = sim::readPngRgb8(
                      file, sim::PngSizeLimit::exactly(cam.width, cam.height, "camera " + cam.id));
                  !image) {
-        return std::unexpected(image.error());
+        return std::unexpected(set.poses[p].name + ": " + image.error() +
+                               ": capture this pose again or remove its folder");
       } else if (auto corners = findTargetCorners(set.target, image->view()); corners.empty()) {
-        use.note = "target not found (not wholly in view, too dark or blurred)";
+        use.note = "target not found (not wholly in view, too dark or blurred): not used";
       } else {
         View v{.pose = p, .corners = {}};
         for (const auto& q : corners) {
@@ -244,13 +247,20 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
       fit.poses.push_back(std::move(use));
     }
     const auto tooFew = [&] {
-      std::string found;
+      std::string used;
       for (const View& v : views) {
-        found += (found.empty() ? "" : ", ") + set.poses[v.pose].name;
+        used += (used.empty() ? "" : ", ") + set.poses[v.pose].name;
       }
-      return cam.id + ": the target was found in " + std::to_string(views.size()) + " poses (" +
-             (found.empty() ? "none" : found) + "); at least " + std::to_string(kMinPoses) +
-             " are needed: capture more with the whole board in " + cam.id + "'s view";
+      std::string dropped;
+      for (const PoseUse& use : fit.poses) {
+        if (!use.note.empty()) {
+          dropped += "; " + use.pose + ": " + use.note;
+        }
+      }
+      return cam.id + ": the target is usable in " + std::to_string(views.size()) + " poses (" +
+             (used.empty() ? "none" : used) + "), at least " + std::to_string(kMinPoses) +
+             " are needed: capture more with the whole board sharp in " + cam.id + "'s view" +
+             dropped;
     };
     if (static_cast<int>(views.size()) < kMinPoses) {
       return std::unexpected(tooFew());
@@ -258,7 +268,7 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
     int flags = cv::CALIB_USE_INTRINSIC_GUESS;
     if (cam.dist[4] == 0.0) {
       flags |= cv::CALIB_FIX_K3;  // a sixth-order term the corners of a few poses over-fit
-      fit.fixedAtNominal.push_back("k3");
+      fit.fixedAtNominal.emplace_back("k3");
     }
     Intrinsics first = solveIntrinsics(views, set.target, cam, flags);
     if (auto spread = checkPoseSpread(views, first, set, cam.id, fit); !spread) {
@@ -328,28 +338,28 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
                              " in " + std::to_string(objects.size()) +
                              " poses; at least 2 are needed to place it: capture poses both see");
     }
-    cv::Mat R;
-    cv::Mat T;
-    cv::Mat E;
-    cv::Mat F;
+    cv::Mat rot;
+    cv::Mat trans;
+    cv::Mat essential;
+    cv::Mat fundamental;
     cv::stereoCalibrate(
         objects, first, other, intrinsics[0].K, intrinsics[0].dist, intrinsics[c].K,
         intrinsics[c].dist,
-        cv::Size(result.cameras[c].camera.width, result.cameras[c].camera.height), R, T, E, F,
-        cv::CALIB_FIX_INTRINSIC,
+        cv::Size(result.cameras[c].camera.width, result.cameras[c].camera.height), rot, trans,
+        essential, fundamental, cv::CALIB_FIX_INTRINSIC,
         cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-12));
     for (int i = 0; i < 9; ++i) {
-      result.cameras[c].camera.R[static_cast<std::size_t>(i)] = R.at<double>(i / 3, i % 3);
+      result.cameras[c].camera.R[static_cast<std::size_t>(i)] = rot.at<double>(i / 3, i % 3);
     }
     for (int i = 0; i < 3; ++i) {
-      result.cameras[c].camera.t[static_cast<std::size_t>(i)] = T.at<double>(i);
+      result.cameras[c].camera.t[static_cast<std::size_t>(i)] = trans.at<double>(i);
     }
   }
 
   // Each pose's target in the world, from the first camera that found it.
   for (std::size_t c = 0; c < result.cameras.size(); ++c) {
     const algo::Camera& cam = result.cameras[c].camera;
-    const Eigen::Matrix3d Rc =
+    const Eigen::Matrix3d camRot =
         Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(cam.R.data());
     const Eigen::Vector3d tc(cam.t[0], cam.t[1], cam.t[2]);
     for (std::size_t i = 0; i < viewsOf[c].size(); ++i) {
@@ -358,9 +368,9 @@ std::expected<CamerasFit, std::string> calibrateCameras(const CaptureSet& set,
         continue;
       }
       // Target → camera, then camera → world.
-      const Eigen::Matrix3d R = rotation(intrinsics[c].rvecs[i]);
+      const Eigen::Matrix3d rot = rotation(intrinsics[c].rvecs[i]);
       const Eigen::Vector3d t = vector3(intrinsics[c].tvecs[i]);
-      pose = {.known = true, .R = Rc.transpose() * R, .t = Rc.transpose() * (t - tc)};
+      pose = {.known = true, .R = camRot.transpose() * rot, .t = camRot.transpose() * (t - tc)};
     }
   }
   return result;

@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
+#include <iterator>
 #include <system_error>
+#include <utility>
+
+#include "smx/calib/camera_calibration.hpp"
 
 namespace smx::calib {
 namespace fs = std::filesystem;
@@ -21,6 +26,42 @@ fs::path existing(const fs::path& file, std::vector<std::string>& notes, const s
     return file;
   }
   notes.push_back(what + " missing: " + file.string());
+  return {};
+}
+
+std::string fileText(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A device whose frame is missing in every pose cannot be solved at all.
+std::expected<void, std::string> presentSomewhere(const std::vector<PoseFiles>& poses,
+                                                  const std::string& device,
+                                                  const std::string& file, const auto& pick) {
+  if (std::ranges::any_of(poses, [&](const PoseFiles& p) { return !pick(p).empty(); })) {
+    return {};
+  }
+  return std::unexpected(device + ": " + file + " is missing in every pose (" + poses.front().name +
+                         " … " + poses.back().name + "): capture each pose " + "with " + device +
+                         " again, or leave " + device + " out of --rig");
+}
+
+// Two poses with byte-identical frames are one pose copied: real exposures always differ.
+std::expected<void, std::string> checkCopies(const std::vector<PoseFiles>& poses) {
+  std::vector<std::string> seen(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (poses[i].off.empty() || poses[i].off[0].empty()) {
+      continue;
+    }
+    seen[i] = fileText(poses[i].off[0]);
+    for (std::size_t j = 0; j < i; ++j) {
+      if (!seen[j].empty() && seen[j] == seen[i]) {
+        return std::unexpected(poses[i].name + " repeats " + poses[j].name + " (" +
+                               poses[i].off[0].filename().string() +
+                               " is the same file): remove the copy or capture a new pose");
+      }
+    }
+  }
   return {};
 }
 
@@ -46,9 +87,11 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
   if (ec) {
     return std::unexpected(dir.string() + ": cannot list the folder: " + ec.message());
   }
-  if (names.empty()) {
-    return std::unexpected(dir.string() +
-                           ": no pose folders (pose00, pose01, …): capture the target first");
+  if (std::cmp_less(names.size(), kMinPoses)) {
+    return std::unexpected(
+        dir.string() + ": " + std::to_string(names.size()) +
+        " pose folders (pose00, pose01, …); at least " + std::to_string(kMinPoses) +
+        " are needed: capture more poses, the target tilted differently in each");
   }
   std::ranges::sort(names);
   for (const std::string& name : names) {
@@ -66,6 +109,24 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
       }
     }
     set.poses.push_back(std::move(pose));
+  }
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const std::string& cam = rig.cameras[c].id;
+    auto ok = presentSomewhere(set.poses, cam, cam + ".png",
+                               [c](const PoseFiles& p) -> const fs::path& { return p.off[c]; });
+    for (std::size_t j = 0; ok && j < rig.projectors.size(); ++j) {
+      const std::string& proj = rig.projectors[j].id;
+      std::string file = proj;
+      file.append(".").append(cam).append(".png");
+      ok = presentSomewhere(set.poses, proj, file,
+                            [c, j](const PoseFiles& p) -> const fs::path& { return p.lit[j][c]; });
+    }
+    if (!ok) {
+      return std::unexpected(ok.error());
+    }
+  }
+  if (auto ok = checkCopies(set.poses); !ok) {
+    return std::unexpected(ok.error());
   }
   return set;
 }

@@ -80,7 +80,8 @@ std::expected<void, std::string> decodeView(const algo::Camera& camera,
     return std::unexpected(ok.error().message);
   }
   const algo::ConstStripePlane plane = pipeline->stripe(0);
-  stripe.assign(static_cast<std::size_t>(camera.width * camera.height), algo::kNoStripe);
+  stripe.assign(static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height),
+                algo::kNoStripe);
   for (int y = 0; y < camera.height; ++y) {
     const auto row = plane.row(y);
     std::copy(row.begin(), row.end(),
@@ -125,15 +126,19 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
       if (files.lit[projector][c].empty() || files.off[c].empty()) {
         continue;  // the capture set's notes name the missing file
       }
-      const auto limit =
-          sim::PngSizeLimit::exactly(camera.width, camera.height, "camera " + camera.id);
+      const std::string owner = "camera " + camera.id;  // outlives the limit's view of it
+      const auto limit = sim::PngSizeLimit::exactly(camera.width, camera.height, owner);
+      const auto unreadable = [&](const std::string& error) {
+        return std::unexpected(files.name + ": " + error +
+                               ": capture this pose again or remove its folder");
+      };
       auto lit = sim::readPngRgb8(files.lit[projector][c], limit);
       if (!lit) {
-        return std::unexpected(lit.error());
+        return unreadable(lit.error());
       }
       auto off = sim::readPngRgb8(files.off[c], limit);
       if (!off) {
-        return std::unexpected(off.error());
+        return unreadable(off.error());
       }
       const Eigen::Vector3d middle =
           pose.R * Eigen::Vector3d((target.cols - 1) * target.squareM / 2,
@@ -145,7 +150,7 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
         return std::unexpected(files.name + ": " + proj.id + " seen by " + camera.id + ": " +
                                ok.error());
       }
-      const std::size_t decoded = static_cast<std::size_t>(
+      const auto decoded = static_cast<std::size_t>(
           std::ranges::count_if(stripe, [](std::int32_t s) { return s != algo::kNoStripe; }));
       if (decoded == 0) {
         notes.push_back(files.name + ": no stripe of " + proj.id + " decoded in " + camera.id +
@@ -156,7 +161,9 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
           std::max(1, static_cast<int>(std::sqrt(static_cast<double>(decoded) / kSamplesPerView)));
       for (int y = 0; y < camera.height; y += step) {
         for (int x = 0; x < camera.width; x += step) {
-          const std::int32_t s = stripe[static_cast<std::size_t>(y * camera.width + x)];
+          const std::int32_t s =
+              stripe[(static_cast<std::size_t>(y) * static_cast<std::size_t>(camera.width)) +
+                     static_cast<std::size_t>(x)];
           if (s == algo::kNoStripe) {
             continue;
           }
@@ -180,6 +187,11 @@ std::expected<std::vector<StripeSample>, std::string> stripeSamples(
         }
       }
     }
+  }
+  if (samples.empty()) {
+    return std::unexpected(proj.id + ": no stripe decoded on the target in any pose (its frames " +
+                           "look unlit): is " + proj.id + " on in its frames and aimed at the " +
+                           "target?");
   }
   return samples;
 }

@@ -17,6 +17,9 @@ namespace smx::calib {
 // a sharp, flat target fits to a small fraction of a pixel.
 inline constexpr double kGoodCameraRmsPx = 0.5;
 inline constexpr double kGoodProjectorRmsPx = 0.5;
+// A projector whose stripes fit worse than this did not solve: its frames contradict each other
+// (moved between poses, or another projector's frames), and its geometry would be wrong.
+inline constexpr double kFailProjectorRmsPx = 2.0;
 
 struct Calibration {
   algo::Rig rig;  // the nominal's ids, sizes and patterns; the calibrated geometry
@@ -29,7 +32,8 @@ struct Calibration {
 };
 
 // Calibrates every camera and projector of `nominal` from the capture set in `dir`. An error
-// names the pose, device or file and what to do; nothing is solved halfway.
+// names the pose, device or file and what to do, or says that the solve failed; nothing is
+// solved halfway.
 [[nodiscard]] std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
                                                                 const std::filesystem::path& dir);
 

@@ -24,11 +24,13 @@ struct CaptureSet {
   std::filesystem::path dir;
   Target target;
   std::vector<PoseFiles> poses;    // in name order
-  std::vector<std::string> notes;  // files missing, for the report
+  std::vector<std::string> notes;  // files missing in some poses, for the report
 };
 
 // Reads target.json and lists the pose folders. Ids of the rig name the files; anything that
-// is not a pose folder is ignored. Errors: no target.json, a bad one, no pose folder.
+// is not a pose folder is ignored. Errors: no target.json, a bad one, fewer than kMinPoses pose
+// folders, a camera's or projector's frame missing in every pose, a pose folder copied from
+// another. Frames missing in some poses only are notes.
 [[nodiscard]] std::expected<CaptureSet, std::string> openCaptureSet(
     const std::filesystem::path& dir, const algo::Rig& rig);
 
