@@ -32,6 +32,9 @@ std::expected<Calibration, std::string> calibrate(const algo::Rig& nominal,
   if (!set) {
     return std::unexpected(set.error());
   }
+  if (auto usable = checkCaptureSet(*set, nominal); !usable) {
+    return std::unexpected(usable.error());
+  }
   auto cameras = calibrateCameras(*set, nominal);
   if (!cameras) {
     return std::unexpected(cameras.error());

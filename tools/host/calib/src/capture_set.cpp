@@ -87,11 +87,9 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
   if (ec) {
     return std::unexpected(dir.string() + ": cannot list the folder: " + ec.message());
   }
-  if (std::cmp_less(names.size(), kMinPoses)) {
-    return std::unexpected(
-        dir.string() + ": " + std::to_string(names.size()) +
-        " pose folders (pose00, pose01, …); at least " + std::to_string(kMinPoses) +
-        " are needed: capture more poses, the target tilted differently in each");
+  if (names.empty()) {
+    return std::unexpected(dir.string() +
+                           ": no pose folders (pose00, pose01, …): capture the target first");
   }
   std::ranges::sort(names);
   for (const std::string& name : names) {
@@ -109,6 +107,16 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
       }
     }
     set.poses.push_back(std::move(pose));
+  }
+  return set;
+}
+
+std::expected<void, std::string> checkCaptureSet(const CaptureSet& set, const algo::Rig& rig) {
+  if (std::cmp_less(set.poses.size(), kMinPoses)) {
+    return std::unexpected(
+        set.dir.string() + ": " + std::to_string(set.poses.size()) +
+        " pose folders (pose00, pose01, …); at least " + std::to_string(kMinPoses) +
+        " are needed: capture more poses, the target tilted differently in each");
   }
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const std::string& cam = rig.cameras[c].id;
@@ -128,7 +136,7 @@ std::expected<CaptureSet, std::string> openCaptureSet(const fs::path& dir, const
   if (auto ok = checkCopies(set.poses); !ok) {
     return std::unexpected(ok.error());
   }
-  return set;
+  return {};
 }
 
 }  // namespace smx::calib

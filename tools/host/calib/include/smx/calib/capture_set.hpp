@@ -28,10 +28,15 @@ struct CaptureSet {
 };
 
 // Reads target.json and lists the pose folders. Ids of the rig name the files; anything that
-// is not a pose folder is ignored. Errors: no target.json, a bad one, fewer than kMinPoses pose
-// folders, a camera's or projector's frame missing in every pose, a pose folder copied from
-// another. Frames missing in some poses only are notes.
+// is not a pose folder is ignored; frames missing in some poses are notes. Errors: no
+// target.json, a bad one, no pose folder.
 [[nodiscard]] std::expected<CaptureSet, std::string> openCaptureSet(
     const std::filesystem::path& dir, const algo::Rig& rig);
+
+// Whether the set can calibrate `rig` at all, before any image is read: fewer than kMinPoses
+// poses, a camera's or projector's frame missing in every pose, or a pose folder copied from
+// another (byte-identical frames) are errors naming what to do.
+[[nodiscard]] std::expected<void, std::string> checkCaptureSet(const CaptureSet& set,
+                                                               const algo::Rig& rig);
 
 }  // namespace smx::calib
