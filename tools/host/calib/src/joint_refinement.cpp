@@ -40,8 +40,8 @@ struct PoseParams {
   std::array<double, 3> t{};
 };
 
-std::array<double, 3> angleAxis(const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd aa(R);
+std::array<double, 3> angleAxis(const Eigen::Matrix3d& rot) {
+  const Eigen::AngleAxisd aa(rot);
   const Eigen::Vector3d v = aa.axis() * aa.angle();
   return {v[0], v[1], v[2]};
 }
@@ -56,9 +56,11 @@ Eigen::Matrix3d matrix(const std::array<double, 3>& aa) {
 template <class T>
 void distort(const T* lens, const T& x, const T& y, T& xd, T& yd) {
   const T r2 = x * x + y * y;
-  const T radial = T(1) + lens[0] * r2 + lens[1] * r2 * r2 + lens[4] * r2 * r2 * r2;
-  xd = x * radial + T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
-  yd = y * radial + lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
+  const T radial = static_cast<T>(1) + lens[0] * r2 + lens[1] * r2 * r2 + lens[4] * r2 * r2 * r2;
+  xd =
+      x * radial + static_cast<T>(2) * lens[2] * x * y + lens[3] * (r2 + static_cast<T>(2) * x * x);
+  yd =
+      y * radial + lens[2] * (r2 + static_cast<T>(2) * y * y) + static_cast<T>(2) * lens[3] * x * y;
 }
 
 struct CornerResidual {
@@ -69,7 +71,7 @@ struct CornerResidual {
   template <class T>
   bool operator()(const T* intrinsics, const T* lens, const T* camRotation, const T* camT,
                   const T* poseRotation, const T* poseT, T* residual) const {
-    const T local[3] = {T(target[0]), T(target[1]), T(0)};
+    const T local[3] = {static_cast<T>(target[0]), static_cast<T>(target[1]), static_cast<T>(0)};
     T world[3];
     ceres::AngleAxisRotatePoint(poseRotation, local, world);
     for (int i = 0; i < 3; ++i) {
@@ -83,8 +85,10 @@ struct CornerResidual {
     T xd;
     T yd;
     distort(lens, cam[0] / cam[2], cam[1] / cam[2], xd, yd);
-    residual[0] = (intrinsics[0] * xd + intrinsics[2] - T(image[0])) / T(sigma);
-    residual[1] = (intrinsics[1] * yd + intrinsics[3] - T(image[1])) / T(sigma);
+    residual[0] =
+        (intrinsics[0] * xd + intrinsics[2] - static_cast<T>(image[0])) / static_cast<T>(sigma);
+    residual[1] =
+        (intrinsics[1] * yd + intrinsics[3] - static_cast<T>(image[1])) / static_cast<T>(sigma);
     return true;
   }
 };
@@ -99,41 +103,43 @@ struct StripeResidual {
                   const T* poseRotation, const T* poseT, const T* rotation, const T* centre,
                   const T* projIntrinsics, const T* projLens, T* residual) const {
     // The pixel's ray: undistorted by fixed-point iteration, as OpenCV's undistortPoints does.
-    const T xd = (T(sample->x) - intrinsics[2]) / intrinsics[0];
-    const T yd = (T(sample->y) - intrinsics[3]) / intrinsics[1];
+    const T xd = (static_cast<T>(sample->x) - intrinsics[2]) / intrinsics[0];
+    const T yd = (static_cast<T>(sample->y) - intrinsics[3]) / intrinsics[1];
     T x = xd;
     T y = yd;
     for (int i = 0; i < kUndistortIterations; ++i) {
       const T r2 = x * x + y * y;
-      const T radial = T(1) + lens[0] * r2 + lens[1] * r2 * r2 + lens[4] * r2 * r2 * r2;
-      const T dx = T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
-      const T dy = lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
+      const T radial =
+          static_cast<T>(1) + lens[0] * r2 + lens[1] * r2 * r2 + lens[4] * r2 * r2 * r2;
+      const T dx = static_cast<T>(2) * lens[2] * x * y + lens[3] * (r2 + static_cast<T>(2) * x * x);
+      const T dy = lens[2] * (r2 + static_cast<T>(2) * y * y) + static_cast<T>(2) * lens[3] * x * y;
       x = (xd - dx) / radial;
       y = (yd - dy) / radial;
     }
     // Camera → world: the inverse rotation about the camera centre −Rᵀt.
     const T back[3] = {-camRotation[0], -camRotation[1], -camRotation[2]};
-    const T dirCam[3] = {x, y, T(1)};
+    const T dirCam[3] = {x, y, static_cast<T>(1)};
     const T negT[3] = {-camT[0], -camT[1], -camT[2]};
     T dir[3];
     T origin[3];
     ceres::AngleAxisRotatePoint(back, dirCam, dir);
     ceres::AngleAxisRotatePoint(back, negT, origin);
     // The target's plane: normal = R·ez through t.
-    const T ez[3] = {T(0), T(0), T(1)};
+    const T ez[3] = {static_cast<T>(0), static_cast<T>(0), static_cast<T>(1)};
     T normal[3];
     ceres::AngleAxisRotatePoint(poseRotation, ez, normal);
-    T num = T(0);
-    T den = T(0);
+    T num = static_cast<T>(0);
+    T den = static_cast<T>(0);
     for (int i = 0; i < 3; ++i) {
       num += normal[i] * (poseT[i] - origin[i]);
       den += normal[i] * dir[i];
     }
     const T lambda = num / den;
-    const T X[3] = {origin[0] + lambda * dir[0], origin[1] + lambda * dir[1],
-                    origin[2] + lambda * dir[2]};
-    const T s = detail::stripeAt(*constants, rotation, centre, projIntrinsics, projLens, X);
-    residual[0] = (s - T(sample->stripe)) * T(constants->stripePx) / T(sigma);
+    const T world[3] = {origin[0] + lambda * dir[0], origin[1] + lambda * dir[1],
+                        origin[2] + lambda * dir[2]};
+    const T s = detail::stripeAt(*constants, rotation, centre, projIntrinsics, projLens, world);
+    residual[0] = (s - static_cast<T>(sample->stripe)) * static_cast<T>(constants->stripePx) /
+                  static_cast<T>(sigma);
     return true;
   }
 };
@@ -260,9 +266,9 @@ std::expected<JointFigures, std::string> refineJointly(
     for (std::size_t i = 0; i < 5; ++i) {
       cam.dist[i] = cams[c].lens[i];
     }
-    const Eigen::Matrix3d R = matrix(cams[c].rotation);
+    const Eigen::Matrix3d rot = matrix(cams[c].rotation);
     for (int i = 0; i < 9; ++i) {
-      cam.R[static_cast<std::size_t>(i)] = R(i / 3, i % 3);
+      cam.R[static_cast<std::size_t>(i)] = rot(i / 3, i % 3);
     }
     cam.t = cams[c].t;
   }
@@ -279,8 +285,8 @@ std::expected<JointFigures, std::string> refineJointly(
       std::vector<double> pose;
       for (std::size_t i = 0; i < fit.corners[v].size(); ++i) {
         const TargetPose& tp = cameras.targets[v];
-        const Eigen::Vector3d X = tp.R * Eigen::Vector3d(corners[i].x, corners[i].y, 0) + tp.t;
-        const auto q = algo::lens::project(fit.camera, {X[0], X[1], X[2]});
+        const Eigen::Vector3d world = tp.R * Eigen::Vector3d(corners[i].x, corners[i].y, 0) + tp.t;
+        const auto q = algo::lens::project(fit.camera, {world[0], world[1], world[2]});
         if (q) {
           pose.push_back(q->x - fit.corners[v][i][0]);
           pose.push_back(q->y - fit.corners[v][i][1]);

@@ -31,9 +31,10 @@ struct StripeResidual {
   template <class T>
   bool operator()(const T* rotation, const T* centre, const T* intrinsics, const T* lens,
                   T* residual) const {
-    const T X[3] = {T(sample->point[0]), T(sample->point[1]), T(sample->point[2])};
-    const T s = detail::stripeAt(*constants, rotation, centre, intrinsics, lens, X);
-    residual[0] = (s - T(sample->stripe)) * T(constants->stripePx);
+    const T world[3] = {static_cast<T>(sample->point[0]), static_cast<T>(sample->point[1]),
+                        static_cast<T>(sample->point[2])};
+    const T s = detail::stripeAt(*constants, rotation, centre, intrinsics, lens, world);
+    residual[0] = (s - static_cast<T>(sample->stripe)) * static_cast<T>(constants->stripePx);
     return true;
   }
 };

@@ -52,11 +52,11 @@ struct ProjectorParams {
 };
 
 [[nodiscard]] inline ProjectorParams paramsOf(const algo::Projector& nominal) {
-  const Eigen::Matrix3d R =
+  const Eigen::Matrix3d rot =
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(nominal.R.data());
   const Eigen::Vector3d c =
-      -R.transpose() * Eigen::Vector3d(nominal.t[0], nominal.t[1], nominal.t[2]);
-  const Eigen::AngleAxisd aa(R);
+      -rot.transpose() * Eigen::Vector3d(nominal.t[0], nominal.t[1], nominal.t[2]);
+  const Eigen::AngleAxisd aa(rot);
   const Eigen::Vector3d rv = aa.axis() * aa.angle();
   return {.rotation = {rv[0], rv[1], rv[2]},
           .centre = {c[0], c[1], c[2]},
@@ -70,11 +70,11 @@ struct ProjectorParams {
   algo::Projector out = nominal;
   const Eigen::Vector3d rv(p.rotation[0], p.rotation[1], p.rotation[2]);
   const double angle = rv.norm();
-  const Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, rv / angle).toRotationMatrix()
-                                      : Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d t = -R * Eigen::Vector3d(p.centre[0], p.centre[1], p.centre[2]);
+  const Eigen::Matrix3d rot = angle > 0 ? Eigen::AngleAxisd(angle, rv / angle).toRotationMatrix()
+                                        : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d t = -rot * Eigen::Vector3d(p.centre[0], p.centre[1], p.centre[2]);
   for (int i = 0; i < 9; ++i) {
-    out.R[static_cast<std::size_t>(i)] = R(i / 3, i % 3);
+    out.R[static_cast<std::size_t>(i)] = rot(i / 3, i % 3);
   }
   out.t = {t[0], t[1], t[2]};
   const double scale = p.intrinsics[0];
@@ -84,24 +84,30 @@ struct ProjectorParams {
   return out;
 }
 
-// The stripe coordinate (algo::stripeCoordinate) the projector casts on world point X.
+// The stripe coordinate (algo::stripeCoordinate) the projector casts on the world point.
 template <class T>
 T stripeAt(const ProjectorConstants& k, const T* rotation, const T* centre, const T* intrinsics,
-           const T* lens, const T* X) {
-  const T rel[3] = {X[0] - centre[0], X[1] - centre[1], X[2] - centre[2]};
+           const T* lens, const T* world) {
+  const T rel[3] = {world[0] - centre[0], world[1] - centre[1], world[2] - centre[2]};
   T dev[3];
   ceres::AngleAxisRotatePoint(rotation, rel, dev);
   const T x = dev[0] / dev[2];
   const T y = dev[1] / dev[2];
   const T r2 = x * x + y * y;
-  const T radial = T(1) + lens[0] * r2 + lens[1] * r2 * r2 + T(k.k3) * r2 * r2 * r2;
-  const T xd = x * radial + T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
-  const T yd = y * radial + lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
-  const T u = intrinsics[0] * T(k.fx) * xd + T(k.cx) + intrinsics[1] * T(k.cosA);
-  const T v = intrinsics[0] * T(k.fy) * yd + T(k.cy) + intrinsics[1] * T(k.sinA);
-  const T along =
-      (u - T(k.patternCu)) * T(k.cosA) + (v - T(k.patternCv)) * T(k.sinA) - T(k.offsetPx);
-  return along / T(k.stripePx) + T(algo::stripe::kStripes / 2.0);
+  const T radial =
+      static_cast<T>(1) + lens[0] * r2 + lens[1] * r2 * r2 + static_cast<T>(k.k3) * r2 * r2 * r2;
+  const T xd =
+      x * radial + static_cast<T>(2) * lens[2] * x * y + lens[3] * (r2 + static_cast<T>(2) * x * x);
+  const T yd =
+      y * radial + lens[2] * (r2 + static_cast<T>(2) * y * y) + static_cast<T>(2) * lens[3] * x * y;
+  const T u = intrinsics[0] * static_cast<T>(k.fx) * xd + static_cast<T>(k.cx) +
+              intrinsics[1] * static_cast<T>(k.cosA);
+  const T v = intrinsics[0] * static_cast<T>(k.fy) * yd + static_cast<T>(k.cy) +
+              intrinsics[1] * static_cast<T>(k.sinA);
+  const T along = (u - static_cast<T>(k.patternCu)) * static_cast<T>(k.cosA) +
+                  (v - static_cast<T>(k.patternCv)) * static_cast<T>(k.sinA) -
+                  static_cast<T>(k.offsetPx);
+  return along / static_cast<T>(k.stripePx) + static_cast<T>(algo::stripe::kStripes / 2.0);
 }
 
 // The centre along the stripes' direction is not observed (every boundary surface contains
@@ -112,19 +118,19 @@ struct CentrePrior {
   Eigen::Vector3d direction;  // unit, world
 
   CentrePrior(const algo::Projector& p, const ProjectorConstants& k) {
-    const Eigen::Matrix3d R =
+    const Eigen::Matrix3d rot =
         Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(p.R.data());
-    nominal = -R.transpose() * Eigen::Vector3d(p.t[0], p.t[1], p.t[2]);
-    direction = (R.transpose() * Eigen::Vector3d(-k.sinA, k.cosA, 0.0)).normalized();
+    nominal = -rot.transpose() * Eigen::Vector3d(p.t[0], p.t[1], p.t[2]);
+    direction = (rot.transpose() * Eigen::Vector3d(-k.sinA, k.cosA, 0.0)).normalized();
   }
 
   template <class T>
   bool operator()(const T* centre, T* residual) const {
-    T along = T(0);
+    T along = static_cast<T>(0);
     for (int i = 0; i < 3; ++i) {
-      along += (centre[i] - T(nominal[i])) * T(direction[i]);
+      along += (centre[i] - static_cast<T>(nominal[i])) * static_cast<T>(direction[i]);
     }
-    residual[0] = along / T(kSigmaM);
+    residual[0] = along / static_cast<T>(kSigmaM);
     return true;
   }
 };
@@ -140,7 +146,8 @@ struct LensPrior {
   template <class T>
   bool operator()(const T* lens, T* residual) const {
     for (std::size_t i = 0; i < 4; ++i) {
-      residual[i] = (lens[i] - T(nominal[i])) / T(kSigma[i]) * T(scale);
+      residual[i] = (lens[i] - static_cast<T>(nominal[i])) / static_cast<T>(kSigma[i]) *
+                    static_cast<T>(scale);
     }
     return true;
   }

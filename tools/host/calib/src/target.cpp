@@ -44,7 +44,7 @@ std::expected<Target, std::string> parseTarget(std::string_view json) {
     config::FieldReader r;
     const auto type = r.text(*doc, "", "type", "\"checkerboard\"");
     if (type && *type != kTypes[0]) {
-      return std::unexpected("type: must be \"checkerboard\" (the only target type), got \"" +
+      return std::unexpected(R"(type: must be "checkerboard" (the only target type), got ")" +
                              *type + "\"");
     }
     Target target;
@@ -81,7 +81,7 @@ std::expected<Target, std::string> parseTarget(std::string_view json) {
              "or both odd a half turn looks the same, so its corners cannot be named");
     }
     if (!r.ok()) {
-      return std::unexpected(message(*r.firstError()));
+      return std::unexpected(message(r.firstError().value_or(config::FieldError{})));
     }
     return target;
   } catch (const std::exception& e) {
@@ -103,7 +103,7 @@ std::expected<Target, std::string> loadTarget(const std::filesystem::path& file)
 
 std::vector<TargetPoint> innerCorners(const Target& target) {
   std::vector<TargetPoint> points;
-  points.reserve(static_cast<std::size_t>(target.cols * target.rows));
+  points.reserve(static_cast<std::size_t>(target.cols) * static_cast<std::size_t>(target.rows));
   for (int r = 0; r < target.rows; ++r) {
     for (int c = 0; c < target.cols; ++c) {
       points.push_back({c * target.squareM, r * target.squareM});
