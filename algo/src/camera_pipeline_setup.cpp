@@ -35,6 +35,16 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
   if (!(options.depthUnitM > 0.0) || !std::isfinite(options.depthUnitM)) {
     return std::unexpected("pipeline: the depth unit must be positive");
   }
+  if (!(options.minDepthM >= 0.0) || !(options.maxDepthM > options.minDepthM) ||
+      options.minConfidence < 1 || options.minConfidence > 255) {
+    return std::unexpected(
+        "pipeline: the depth window needs 0 <= min < max and a confidence of 1 to 255");
+  }
+  // Depths are whole units: keep every unit whose depth lies inside [min, max].
+  const auto units = [&](double m) { return std::clamp(m / options.depthUnitM, 1.0, 65535.0); };
+  setup.window = {.minUnits = static_cast<std::uint16_t>(std::ceil(units(options.minDepthM))),
+                  .maxUnits = static_cast<std::uint16_t>(std::floor(units(options.maxDepthM))),
+                  .minConfidence = static_cast<std::uint8_t>(options.minConfidence)};
   setup.trust = options.trust;
   setup.trust.tolerance.minUnits =
       static_cast<int>(std::clamp(std::ceil(kGrossToleranceM / options.depthUnitM), 1.0, 65535.0));

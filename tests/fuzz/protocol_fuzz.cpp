@@ -122,6 +122,12 @@ void decodeAny(const Message& message) {
     case MessageType::kRawFrame:
       checkRawFrame(message);
       break;
+    case MessageType::kConfig:
+      (void)decodeConfig(message.payload);
+      break;
+    case MessageType::kSetConfig:
+      (void)decodeSetConfig(message.payload);
+      break;
     default:
       (void)decodeEmpty(message.payload);
       break;
@@ -134,7 +140,7 @@ void decodeAny(const Message& message) {
 std::vector<std::byte> framed(std::span<const std::byte> records) {
   std::vector<std::byte> stream;
   while (records.size() >= 3) {
-    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 12U);
+    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 15U);
     const std::size_t length = std::min<std::size_t>(
         records.size() - 3,
         std::to_integer<std::size_t>(records[1]) | std::to_integer<std::size_t>(records[2]) << 8U);

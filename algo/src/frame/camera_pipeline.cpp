@@ -95,6 +95,7 @@ Result<CameraPipeline> CameraPipeline::create(const CameraPipelineSetup& setup, 
   c.layout_ = setup.layout;
   c.edgeJumpPermille_ = setup.edgeJumpPermille;
   c.trust_ = setup.trust;
+  c.window_ = setup.window;
   auto demux = Demultiplexer::create(setup.layout, setup.predictedAngles, arena);
   if (!demux) {
     return undo(demux.error());
@@ -181,9 +182,13 @@ Result<void> CameraPipeline::merge() {
     confidences[i] = confidences_[i];
   }
   const auto n = static_cast<std::size_t>(layout_.projectors);
-  return mergeRanges(std::span<const ConstDepthPlane>(inputs.data(), n),
-                     std::span<const ImageView<const std::uint8_t>>(confidences.data(), n), merged_,
-                     mergedConfidence_, trust_.tolerance);
+  auto merged = mergeRanges(std::span<const ConstDepthPlane>(inputs.data(), n),
+                            std::span<const ImageView<const std::uint8_t>>(confidences.data(), n),
+                            merged_, mergedConfidence_, trust_.tolerance);
+  if (merged && !window_.keepsAll()) {
+    applyDepthWindow(merged_, mergedConfidence_, window_);
+  }
+  return merged;
 }
 
 Result<void> CameraPipeline::run(ConstRgbView image) {

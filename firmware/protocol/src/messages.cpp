@@ -204,6 +204,18 @@ ProtocolResult<std::span<const std::byte>> encode(const CaptureRaw& m, std::span
   return build(MessageType::kCaptureRaw, out, [&](ByteWriter& w) { w.put(m.projectorsMask); });
 }
 
+ProtocolResult<std::span<const std::byte>> encode(const ConfigMessage& m,
+                                                  std::span<std::byte> out) {
+  return build(MessageType::kConfig, out, [&](ByteWriter& w) { w.putString32(m.json); });
+}
+
+ProtocolResult<std::span<const std::byte>> encode(const SetConfig& m, std::span<std::byte> out) {
+  return build(MessageType::kSetConfig, out, [&](ByteWriter& w) {
+    w.put(static_cast<std::uint8_t>(m.mode));
+    w.putString32(m.json);
+  });
+}
+
 ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
                                                           algo::ConstRgbView image,
                                                           std::span<std::byte> out) {
@@ -341,6 +353,28 @@ ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload) 
   CaptureRaw m{in.get<std::uint32_t>()};
   if (auto ok = finished(in); !ok) {
     return std::unexpected(ok.error());
+  }
+  return m;
+}
+
+ProtocolResult<ConfigMessage> decodeConfig(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  const ConfigMessage m{in.getString32()};
+  if (auto ok = finished(in); !ok) {
+    return std::unexpected(ok.error());
+  }
+  return m;
+}
+
+ProtocolResult<SetConfig> decodeSetConfig(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  const auto mode = in.get<std::uint8_t>();
+  const SetConfig m{static_cast<SetConfigMode>(mode), in.getString32()};
+  if (auto ok = finished(in); !ok) {
+    return std::unexpected(ok.error());
+  }
+  if (mode > static_cast<std::uint8_t>(SetConfigMode::kReset)) {
+    return protocolFail(ProtocolErrc::kMalformed, "set-config: unknown mode");
   }
   return m;
 }

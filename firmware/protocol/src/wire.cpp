@@ -10,7 +10,7 @@ namespace smx::protocol {
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
   return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-         value <= static_cast<std::uint8_t>(MessageType::kRawFrame);
+         value <= static_cast<std::uint8_t>(MessageType::kSetConfig);
 }
 
 const char* toString(MessageType type) {
@@ -37,6 +37,12 @@ const char* toString(MessageType type) {
       return "capture-raw";
     case MessageType::kRawFrame:
       return "raw-frame";
+    case MessageType::kGetConfig:
+      return "get-config";
+    case MessageType::kConfig:
+      return "config";
+    case MessageType::kSetConfig:
+      return "set-config";
   }
   return "unknown";
 }

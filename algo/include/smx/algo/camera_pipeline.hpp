@@ -11,6 +11,7 @@
 #include "smx/algo/arena.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/depth_trust.hpp"
+#include "smx/algo/depth_window.hpp"
 #include "smx/algo/error.hpp"
 #include "smx/algo/image_view.hpp"
 #include "smx/algo/range_image.hpp"
@@ -37,6 +38,10 @@ struct PipelineOptions {
   // Per pair: which depths to trust (depth_trust.hpp); its tolerance's minUnits is set from
   // kGrossToleranceM and depthUnitM by prepareCameraPipeline.
   DepthTrustParams trust;
+  // The owner's window on the merged depth (docs/config.md); the defaults keep everything.
+  double minDepthM = 0.0;
+  double maxDepthM = 1e9;
+  int minConfidence = 1;  // 1…255
 };
 
 // Init time (double, allocates): the tables the pipeline needs, computed from the rig.
@@ -46,6 +51,7 @@ struct CameraPipelineSetup {
   int edgeJumpPermille = 20;
   DepthTrustParams trust;
   double depthUnitM = kDefaultDepthUnitM;
+  DepthWindow window;
   std::vector<std::uint16_t> predictedAngles;      // Demultiplexer::create's
   std::vector<TriangulationTables> triangulation;  // per projector
 };
@@ -89,6 +95,7 @@ class CameraPipeline {
   DemuxLayout layout_;
   int edgeJumpPermille_ = 0;
   DepthTrustParams trust_;
+  DepthWindow window_;
   std::optional<Demultiplexer> demux_;
   std::optional<StripeDecoder> decoder_;
   std::array<std::optional<Triangulator>, kMaxProjectors> triangulators_;

@@ -116,6 +116,22 @@ inline constexpr std::size_t kRawBandPixelBytes = std::size_t{1} << 20U;
          3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
 }
 
+// The device's settings, a stripemux-config/1 document (docs/config.md): every setting in a
+// config message, the ones to change in a set-config.
+struct ConfigMessage {
+  std::string_view json;
+};
+
+enum class SetConfigMode : std::uint8_t {
+  kChange = 0,  // the document's settings replace the stored ones, the others stay
+  kReset = 1,   // every stored setting is dropped first (the board's apply), then the document's
+};
+
+struct SetConfig {
+  SetConfigMode mode = SetConfigMode::kChange;
+  std::string_view json;  // may be empty with kReset
+};
+
 enum class ErrorCode : std::uint16_t {
   kUnsupportedVersion = 1,
   kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
@@ -141,12 +157,16 @@ struct ErrorMessage {
                                                                 std::span<std::byte> out);
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const CaptureRaw& m,
                                                                 std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const ConfigMessage& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const SetConfig& m,
+                                                                std::span<std::byte> out);
 // The band `header.firstRow`, `header.rows` of `image` as a raw-frame message; the header's
 // width and height are taken from the image. kMalformed for a band outside the image.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
                                                                         algo::ConstRgbView image,
                                                                         std::span<std::byte> out);
-// A message without payload: stop-stream, get-statistics.
+// A message without payload: stop-stream, get-statistics, get-config.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type,
                                                                      std::span<std::byte> out);
 // A range frame of `depth` (width × height from the plane). RVL falls back to kNone when the
@@ -172,6 +192,8 @@ struct ErrorMessage {
 [[nodiscard]] ProtocolResult<ErrorMessage> decodeError(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<void> decodeEmpty(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<ConfigMessage> decodeConfig(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<SetConfig> decodeSetConfig(std::span<const std::byte> payload);
 // Checks the band against its own frame size (inside it, pixels = rows × width × 3); the
 // receiver checks the frame size against what the device announced.
 [[nodiscard]] ProtocolResult<RawFrameView> decodeRawFrame(std::span<const std::byte> payload);

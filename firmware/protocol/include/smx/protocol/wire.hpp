@@ -41,6 +41,9 @@ enum class MessageType : std::uint8_t {
   kRangeFrameConfidence = 9,
   kCaptureRaw = 10,  // host → device: one raw frame per camera with the given projectors on
   kRawFrame = 11,    // device → host: a band of rows of one camera's raw frame (RGB8)
+  kGetConfig = 12,   // host → device: the settings the device runs with
+  kConfig = 13,      // device → host: its settings (answer to get-config and set-config)
+  kSetConfig = 14,   // host → device: change settings (stored, then the device restarts)
 };
 
 [[nodiscard]] bool isKnown(MessageType type);

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <expected>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "smx/algo/rig.hpp"
+#include "smx/config/board_json.hpp"
+#include "smx/config/json_errors.hpp"
+
+// config.json, format `stripemux-config/1` (docs/config.md): what an owner changes on a device
+// over its board.json, kept in the device's state directory. Every setting is optional; an absent
+// one is the board's. The same document is a request to change settings: its keys replace the
+// stored ones, the others stay. Init-time code (allocates); never throws.
+namespace smx::config {
+
+inline constexpr std::string_view kDeviceConfigFormat = "stripemux-config/1";
+// Bounds the request and the stored file: a rig.json is a few KiB.
+inline constexpr std::size_t kDeviceConfigMaxBytes = std::size_t{1} << 16U;
+
+enum class Compression : std::uint8_t { kRvl, kNone };
+
+struct DeviceConfig {
+  std::optional<int> fps;                  // camera frame rate, 1…120
+  std::optional<Compression> compression;  // what the device sends range frames as
+  std::optional<double> depthMinM;         // depths nearer are dropped
+  std::optional<double> depthMaxM;         // depths farther are dropped
+  std::optional<int> confidenceMin;        // depths less confident are dropped, 1…255
+  std::optional<algo::Rig> rig;            // the rig the device decodes with (a calibration)
+};
+
+// The settings keys, in the order documents list them.
+[[nodiscard]] std::span<const std::string_view> deviceConfigKeys();
+
+// Parses and checks `text` against `board`: every value in range, a rig with the board's cameras
+// (ids, sizes) and projectors (ids, patterns' order), and a depth window the board's depth unit
+// can hold with min < max once combined with `stored` (the settings it would be merged with).
+[[nodiscard]] std::expected<DeviceConfig, FieldError> parseDeviceConfig(
+    std::string_view text, const Board& board, const DeviceConfig& stored = {});
+
+// `stored` with every setting `change` has replaced.
+[[nodiscard]] DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change);
+
+// The settings as a config.json document (only those set).
+[[nodiscard]] std::string toJson(const DeviceConfig& config);
+
+// Every setting as the device runs with it: `config`'s where set, the board's otherwise.
+[[nodiscard]] std::string effectiveJson(const DeviceConfig& config, const Board& board);
+
+// `board` as the device runs it with `config`: the frame rate of every camera and the rig.
+[[nodiscard]] Board appliedTo(const DeviceConfig& config, Board board);
+
+}  // namespace smx::config

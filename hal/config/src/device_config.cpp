@@ -1,0 +1,227 @@
+#include "smx/config/device_config.hpp"
+
+#include <array>
+#include <exception>
+#include <nlohmann/json.hpp>
+#include <utility>
+
+#include "smx/algo/range_image.hpp"
+#include "smx/config/field_reader.hpp"
+#include "smx/config/json_reader.hpp"
+#include "smx/config/rig_json.hpp"
+
+namespace smx::config {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr std::array<std::string_view, 6> kSettingKeys = {
+    "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
+constexpr std::array<std::string_view, 7> kTopKeys = {
+    "format", "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
+constexpr std::array<std::string_view, 2> kCompressions = {"rvl", "none"};
+
+constexpr std::array<FormatHint, 2> kOtherFormats = {
+    {{"stripemux-rig/", " (this is a rig.json; a configuration holds it under \"rig\")"},
+     {"stripemux-board/", " (this is a board.json, which the device's owner does not change)"}}};
+constexpr DocumentSpec kConfigDocument = {.name = "config.json",
+                                          .format = kDeviceConfigFormat,
+                                          .topKeys = kTopKeys,
+                                          .maxBytes = kDeviceConfigMaxBytes,
+                                          .sizeNote = "",
+                                          .nestingNeeded = 5,
+                                          .maxNesting = 16,
+                                          .otherFormats = kOtherFormats};
+
+// The rig must describe the board's devices: the device decodes the cameras it has with the
+// projectors its trigger lines switch.
+void checkRigFitsBoard(FieldReader& r, const algo::Rig& rig, const algo::Rig& board) {
+  if (rig.cameras.size() != board.cameras.size() ||
+      rig.projectors.size() != board.projectors.size()) {
+    r.fail("rig", "has " + std::to_string(rig.cameras.size()) + " cameras and " +
+                      std::to_string(rig.projectors.size()) + " projectors; the board has " +
+                      std::to_string(board.cameras.size()) + " and " +
+                      std::to_string(board.projectors.size()));
+    return;
+  }
+  for (std::size_t i = 0; i < rig.cameras.size() && r.ok(); ++i) {
+    const auto& a = rig.cameras[i];
+    const auto& b = board.cameras[i];
+    const std::string at = element("rig.cameras", i);
+    if (a.id != b.id) {
+      r.fail(member(at, "id"), jsonQuote(a.id) + " is not the board's camera " + jsonQuote(b.id));
+    } else if (a.width != b.width || a.height != b.height) {
+      r.fail(at, "is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                     "; the board's camera is " + std::to_string(b.width) + "x" +
+                     std::to_string(b.height));
+    }
+  }
+  for (std::size_t i = 0; i < rig.projectors.size() && r.ok(); ++i) {
+    if (rig.projectors[i].id != board.projectors[i].id) {
+      r.fail(member(element("rig.projectors", i), "id"), jsonQuote(rig.projectors[i].id) +
+                                                             " is not the board's projector " +
+                                                             jsonQuote(board.projectors[i].id));
+    }
+  }
+}
+
+void readRig(FieldReader& r, const Json& doc, const Board& board, DeviceConfig& out) {
+  const Json* v = r.find(doc, "rig");
+  if (v == nullptr) {
+    return;
+  }
+  if (!v->is_object()) {
+    r.fail("rig", "must be an object (a stripemux-rig/1 document), got " + describe(*v));
+    return;
+  }
+  auto rig = parseRig(v->dump());
+  if (!rig) {
+    r.fail(rig.error().field.empty() ? "rig" : "rig." + rig.error().field, rig.error().problem);
+    return;
+  }
+  checkRigFitsBoard(r, *rig, board.rig);
+  out.rig = std::move(*rig);
+}
+
+void readDepthWindow(FieldReader& r, const Json& doc, const Board& board,
+                     const DeviceConfig& stored, DeviceConfig& out) {
+  for (const auto& [key, value] :
+       {std::pair{"depth_min_m", &out.depthMinM}, std::pair{"depth_max_m", &out.depthMaxM}}) {
+    if (const Json* v = r.find(doc, key); v != nullptr) {
+      *value = r.number(*v, key, Range::kNonNegative);
+    }
+  }
+  if (!r.ok()) {
+    return;
+  }
+  const double farthest = algo::maxStoredDepthM(board.config.depthUnitM);
+  const double lo = out.depthMinM.value_or(stored.depthMinM.value_or(0.0));
+  const double hi = out.depthMaxM.value_or(stored.depthMaxM.value_or(farthest));
+  if (!(lo < hi)) {
+    r.fail(out.depthMaxM ? "depth_max_m" : "depth_min_m",
+           "the depth window would be empty: depth_min_m " + formatNumber(lo) +
+               " must be less than depth_max_m " + formatNumber(hi));
+  } else if (lo >= farthest) {
+    r.fail("depth_min_m", "must be less than " + formatNumber(farthest) +
+                              " m, the farthest depth the board's depth unit stores");
+  }
+}
+
+std::expected<DeviceConfig, FieldError> parseImpl(std::string_view text, const Board& board,
+                                                  const DeviceConfig& stored) {
+  auto parsed = parseDocument(text, kConfigDocument);
+  if (!parsed) {
+    return std::unexpected(parsed.error());
+  }
+  const Json& doc = *parsed;
+  FieldReader r;
+  DeviceConfig out;
+  if (r.find(doc, "fps") != nullptr) {
+    int fps = 0;
+    r.integer(doc, "", "fps", 1, 120, "frames per second", fps);
+    out.fps = fps;
+  }
+  if (const Json* v = r.find(doc, "compression"); v != nullptr) {
+    if (!v->is_string() ||
+        std::ranges::find(kCompressions, v->get_ref<const std::string&>()) == kCompressions.end()) {
+      r.fail("compression", "must be one of: " + joined(kCompressions) + ", got " + describe(*v));
+    } else {
+      out.compression = *v == "rvl" ? Compression::kRvl : Compression::kNone;
+    }
+  }
+  readDepthWindow(r, doc, board, stored, out);
+  if (r.find(doc, "confidence_min") != nullptr) {
+    int confidence = 0;
+    r.integer(doc, "", "confidence_min", 1, 255, "the least confidence kept", confidence);
+    out.confidenceMin = confidence;
+  }
+  readRig(r, doc, board, out);
+  if (!r.ok()) {
+    return std::unexpected(r.firstError().value_or(FieldError{}));
+  }
+  return out;
+}
+
+Json settingsJson(const DeviceConfig& c) {
+  Json doc = Json::object();
+  doc["format"] = kDeviceConfigFormat;
+  if (c.fps) {
+    doc["fps"] = *c.fps;
+  }
+  if (c.compression) {
+    doc["compression"] = *c.compression == Compression::kRvl ? "rvl" : "none";
+  }
+  if (c.depthMinM) {
+    doc["depth_min_m"] = *c.depthMinM;
+  }
+  if (c.depthMaxM) {
+    doc["depth_max_m"] = *c.depthMaxM;
+  }
+  if (c.confidenceMin) {
+    doc["confidence_min"] = *c.confidenceMin;
+  }
+  if (c.rig) {
+    doc["rig"] = Json::parse(toJson(*c.rig));
+  }
+  return doc;
+}
+
+}  // namespace
+
+std::span<const std::string_view> deviceConfigKeys() {
+  return kSettingKeys;
+}
+
+std::expected<DeviceConfig, FieldError> parseDeviceConfig(std::string_view text, const Board& board,
+                                                          const DeviceConfig& stored) {
+  try {
+    return parseImpl(text, board, stored);
+  } catch (const std::exception& e) {
+    return std::unexpected(
+        FieldError{{}, std::string("cannot read the configuration: ") + e.what()});
+  }
+}
+
+DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change) {
+  const auto take = [](auto& into, const auto& from) {
+    if (from) {
+      into = from;
+    }
+  };
+  take(stored.fps, change.fps);
+  take(stored.compression, change.compression);
+  take(stored.depthMinM, change.depthMinM);
+  take(stored.depthMaxM, change.depthMaxM);
+  take(stored.confidenceMin, change.confidenceMin);
+  take(stored.rig, change.rig);
+  return stored;
+}
+
+std::string toJson(const DeviceConfig& config) {
+  return settingsJson(config).dump(2) + "\n";
+}
+
+std::string effectiveJson(const DeviceConfig& config, const Board& board) {
+  DeviceConfig all = config;
+  all.fps = config.fps.value_or(board.config.cameras.front().format.fps);
+  all.compression = config.compression.value_or(Compression::kRvl);
+  all.depthMinM = config.depthMinM.value_or(0.0);
+  all.depthMaxM = config.depthMaxM.value_or(algo::maxStoredDepthM(board.config.depthUnitM));
+  all.confidenceMin = config.confidenceMin.value_or(1);
+  all.rig = config.rig.value_or(board.rig);
+  return toJson(all);
+}
+
+Board appliedTo(const DeviceConfig& config, Board board) {
+  if (config.fps) {
+    for (auto& camera : board.config.cameras) {
+      camera.format.fps = *config.fps;
+    }
+  }
+  if (config.rig) {
+    board.rig = *config.rig;
+  }
+  return board;
+}
+
+}  // namespace smx::config

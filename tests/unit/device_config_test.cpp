@@ -1,0 +1,138 @@
+// config.json (docs/config.md): settings read and checked against the board, errors naming the
+// key, a stored configuration merged with a change, and the board as the device runs it.
+#include "smx/config/device_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "smx/algo/range_image.hpp"
+#include "smx/config/rig_json.hpp"
+#include "source_dir.hpp"
+
+namespace smx::config {
+namespace {
+
+Board simBoard() {
+  auto board = loadBoard(test::sourceDir() / "boards" / "sim");
+  EXPECT_TRUE(board.has_value()) << board.error().message();
+  return *board;
+}
+
+std::string doc(const std::string& body) {
+  return R"({"format": "stripemux-config/1")" + (body.empty() ? "" : ", " + body) + "}";
+}
+
+TEST(DeviceConfig, ReadsEverySetting) {
+  const Board board = simBoard();
+  const std::string rig = toJson(board.rig);
+  const auto config = parseDeviceConfig(doc(R"("fps": 12, "compression": "none", "depth_min_m": 0.3,
+                                "depth_max_m": 1.5, "confidence_min": 100, "rig": )" +
+                                            rig),
+                                        board);
+  ASSERT_TRUE(config.has_value()) << config.error().field << ": " << config.error().problem;
+  EXPECT_EQ(config->fps, 12);
+  EXPECT_EQ(config->compression, Compression::kNone);
+  EXPECT_EQ(config->depthMinM, 0.3);
+  EXPECT_EQ(config->depthMaxM, 1.5);
+  EXPECT_EQ(config->confidenceMin, 100);
+  ASSERT_TRUE(config->rig.has_value());
+  EXPECT_EQ(config->rig->cameras[1].id, "cam1");
+}
+
+// Each bad document is refused with the field that is wrong and words that say why.
+TEST(DeviceConfig, BadValuesAreRefusedNamingTheKey) {
+  const Board board = simBoard();
+  algo::Rig otherIds = board.rig;
+  otherIds.cameras[0].id = "left";
+  algo::Rig otherSize = board.rig;
+  otherSize.cameras[1].width /= 2;
+  otherSize.cameras[0].width /= 2;
+  struct Case {
+    std::string text;
+    std::string field;
+    std::string words;
+  };
+  const Case cases[] = {
+      {doc(R"("fps": 0)"), "fps", "from 1 to 120"},
+      {doc(R"("fps": 12.5)"), "fps", "integer"},
+      {doc(R"("compression": "zip")"), "compression", "rvl, none"},
+      {doc(R"("exposure": 3)"), "", "unknown key \"exposure\""},
+      {doc(R"("depth_min_m": -1)"), "depth_min_m", "negative"},
+      {doc(R"("depth_min_m": 2, "depth_max_m": 1)"), "depth_max_m", "empty"},
+      {doc(R"("confidence_min": 256)"), "confidence_min", "from 1 to 255"},
+      {doc(R"("rig": 5)"), "rig", "object"},
+      {doc(R"("rig": )" + toJson(otherIds)), "rig.cameras[0].id", "\"cam0\""},
+      {doc(R"("rig": )" + toJson(otherSize)), "rig.cameras[0]", "the board's camera is"},
+      {R"({"format": "stripemux-rig/1"})", "format", "rig.json"},
+      {"{", "", "not valid JSON"},
+  };
+  for (const Case& c : cases) {
+    const auto config = parseDeviceConfig(c.text, board);
+    ASSERT_FALSE(config.has_value()) << c.text;
+    EXPECT_EQ(config.error().field, c.field) << c.text;
+    EXPECT_NE(config.error().problem.find(c.words), std::string::npos)
+        << c.text << " -> " << config.error().problem;
+  }
+}
+
+// A change that only moves the far limit is checked against the stored near one.
+TEST(DeviceConfig, DepthWindowIsCheckedAgainstTheStoredSettings) {
+  const Board board = simBoard();
+  DeviceConfig stored;
+  stored.depthMinM = 1.0;
+  EXPECT_FALSE(parseDeviceConfig(doc(R"("depth_max_m": 0.8)"), board, stored).has_value());
+  EXPECT_TRUE(parseDeviceConfig(doc(R"("depth_max_m": 1.2)"), board, stored).has_value());
+  // The sim board stores 0.1 mm units: 6.5535 m is the farthest depth it holds.
+  EXPECT_FALSE(parseDeviceConfig(doc(R"("depth_min_m": 7)"), board).has_value());
+}
+
+TEST(DeviceConfig, AChangeReplacesOnlyItsKeysAndRoundTrips) {
+  const Board board = simBoard();
+  const auto stored = parseDeviceConfig(doc(R"("fps": 12, "confidence_min": 50)"), board);
+  const auto change = parseDeviceConfig(doc(R"("confidence_min": 80)"), board);
+  ASSERT_TRUE(stored && change);
+  const DeviceConfig result = merged(*stored, *change);
+  EXPECT_EQ(result.fps, 12);
+  EXPECT_EQ(result.confidenceMin, 80);
+  EXPECT_FALSE(result.depthMaxM.has_value());
+  const auto back = parseDeviceConfig(toJson(result), board);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->fps, 12);
+  EXPECT_EQ(back->confidenceMin, 80);
+  EXPECT_FALSE(back->compression.has_value());
+}
+
+TEST(DeviceConfig, EffectiveSettingsFillInTheBoards) {
+  const Board board = simBoard();
+  const auto config = parseDeviceConfig(doc(R"("depth_max_m": 2)"), board);
+  ASSERT_TRUE(config.has_value());
+  const auto all = parseDeviceConfig(effectiveJson(*config, board), board);
+  ASSERT_TRUE(all.has_value());
+  EXPECT_EQ(all->fps, 30);  // boards/sim/board.json
+  EXPECT_EQ(all->compression, Compression::kRvl);
+  EXPECT_EQ(all->depthMinM, 0.0);
+  EXPECT_EQ(all->depthMaxM, 2.0);
+  EXPECT_EQ(all->confidenceMin, 1);
+  ASSERT_TRUE(all->rig.has_value());
+  EXPECT_EQ(toJson(*all->rig), toJson(board.rig));
+}
+
+TEST(DeviceConfig, AppliedToTheBoardSetsFrameRateAndRig) {
+  const Board board = simBoard();
+  algo::Rig moved = board.rig;
+  moved.projectors[0].t[0] += 0.01;
+  DeviceConfig config;
+  config.fps = 7;
+  config.rig = moved;
+  const Board applied = appliedTo(config, board);
+  for (const auto& camera : applied.config.cameras) {
+    EXPECT_EQ(camera.format.fps, 7);
+  }
+  EXPECT_EQ(applied.rig.projectors[0].t[0], moved.projectors[0].t[0]);
+  EXPECT_EQ(applied.config.name, board.config.name);
+}
+
+}  // namespace
+}  // namespace smx::config
