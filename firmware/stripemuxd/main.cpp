@@ -10,6 +10,7 @@
 #include <ctime>
 #include <thread>
 
+#include "settings.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/device/device.hpp"
 #include "smx/hal/board_hal.hpp"
@@ -26,6 +27,7 @@ struct Options {
   std::string bind;
   std::string scene;
   std::string replay;
+  std::string state;
   int fps = 0;
   std::uint64_t frames = 0;
   double statusEveryS = 5;
@@ -57,6 +59,29 @@ void printCounters(const Device& device, const char* prefix) {
   std::fflush(stdout);
 }
 
+// Runs the device until a signal (returns true) or until a set-config asks for a restart with
+// the stored settings (returns false).
+bool serve(Device& device, const Options& opts, std::size_t cameras, std::atomic<bool>& stop) {
+  std::jthread network([&] { device.runNetwork(stop); });
+  timespec last{};
+  clock_gettime(CLOCK_MONOTONIC, &last);
+  while (!stop && !device.restartDue()) {
+    (void)device.serveRawCapture();  // between range captures, when a host asked for one
+    (void)device.captureOnce();
+    if (opts.frames > 0 && device.counters().framesCaptured >= opts.frames * cameras) {
+      stop = true;
+    }
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (static_cast<double>(now.tv_sec - last.tv_sec) >= opts.statusEveryS) {
+      printCounters(device, "status: ");
+      last = now;
+    }
+  }
+  network.join();
+  return stop;
+}
+
 int run(const Options& opts) {
   auto board = smx::config::loadBoard(opts.board);
   if (!board) {
@@ -77,69 +102,92 @@ int run(const Options& opts) {
   for (auto& camera : config.cameras) {
     camera.format.fps = opts.fps > 0 ? opts.fps : camera.format.fps;
   }
+  std::string report;
+  auto settings = smx::firmware::Settings::load(opts.state, *board, report);
+  std::fputs(report.c_str(), stdout);
+  if (!settings) {
+    std::fprintf(stderr, "stripemuxd: %s\n", settings.error().c_str());
+    return 1;
+  }
+  // The HAL is the hardware: it stays while the settings change (the simulated world keeps the
+  // board's rig, whatever rig the owner installs).
   auto hal = smx::hal::createBoardHal(config, board->rig);
   if (!hal) {
     std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), hal.error().c_str());
     return 3;
   }
-  smx::device::DeviceOptions options;
-  options.firmwareVersion = SMX_VERSION;
-  options.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
-  auto device = Device::create(*board, (*hal)->hal(), options);
-  if (!device) {
-    std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), device.error().c_str());
-    return 3;
-  }
-  const auto& rig = board->rig;
-  std::printf(
-      "stripemuxd %s: board %s (%s HAL), %zu cameras %dx%d, %zu projectors, %zu KiB "
-      "working memory\n",
-      SMX_VERSION, config.name.c_str(), std::string(smx::hal::halBackend()).c_str(),
-      rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
-      rig.projectors.size(), (*device)->arenaBytes() / 1024);
+  smx::device::DeviceOptions base;
+  base.firmwareVersion = SMX_VERSION;
+  base.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
+
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
-  std::printf("listening on %s\n",
-              smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
   // Discovery is a convenience: a second device on this machine (tests) goes without it.
   auto discovery = smx::net::DiscoveryResponder::create(
       config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
-  if (!discovery) {
-    std::printf("discovery off: %s\n", discovery.error().c_str());
-  }
-  std::fflush(stdout);
-
   std::atomic<bool> stop = false;
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
   const std::jthread signalThread(waitForSignal, signals, std::ref(stop));
-  std::jthread network([&] { (*device)->runNetwork(stop); });
   std::jthread discoveryThread([&] {
     while (discovery && !stop) {
       (void)(*discovery)->serviceOnce(100'000'000);
     }
   });
 
-  timespec last{};
-  clock_gettime(CLOCK_MONOTONIC, &last);
+  bool started = false;
   while (!stop) {
-    (void)(*device)->serveRawCapture();  // between range captures, when a host asked for one
-    (void)(*device)->captureOnce();
-    if (opts.frames > 0 &&
-        (*device)->counters().framesCaptured >= opts.frames * rig.cameras.size()) {
-      stop = true;
+    auto options = settings->deviceOptions(base);
+    options.setConfig = [&](const smx::protocol::SetConfig& request) {
+      return settings->change(request);
+    };
+    const smx::config::Board running = settings->board();
+    auto device = Device::create(running, (*hal)->hal(), options);
+    if (!device && started) {
+      // Checked before they were stored, yet refused (a camera that cannot run at that rate):
+      // the settings before are the ones the device last ran with.
+      std::printf("settings refused by the device: %s; going back to the settings before\n",
+                  device.error().c_str());
+      if (auto reverted = settings->revert(); !reverted) {
+        std::printf("%s\n", reverted.error().c_str());
+      }
+      device = Device::create(settings->board(), (*hal)->hal(), settings->deviceOptions(base));
     }
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    if (static_cast<double>(now.tv_sec - last.tv_sec) >= opts.statusEveryS) {
-      printCounters(**device, "status: ");
-      last = now;
+    if (!device) {
+      std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(),
+                   device.error().c_str());
+      stop = true;
+      return 3;
+    }
+    const auto& rig = running.rig;
+    if (!started) {
+      std::printf(
+          "stripemuxd %s: board %s (%s HAL), %zu cameras %dx%d, %zu projectors, %zu KiB "
+          "working memory\n",
+          SMX_VERSION, config.name.c_str(), std::string(smx::hal::halBackend()).c_str(),
+          rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
+          rig.projectors.size(), (*device)->arenaBytes() / 1024);
+      std::printf("listening on %s\n",
+                  smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
+      if (!discovery) {
+        std::printf("discovery off: %s\n", discovery.error().c_str());
+      }
+    }
+    std::printf("settings: %s\n", settings->describe().c_str());
+    std::fflush(stdout);
+    started = true;
+    if (serve(**device, opts, rig.cameras.size(), stop)) {
+      printCounters(**device, "stopped: ");
+      break;
+    }
+    printCounters(**device, "restarting with new settings: ");
+    for (smx::hal::Camera* camera : (*hal)->hal().cameras) {
+      (void)camera->stop();
     }
   }
-  network.join();
+  stop = true;
   discoveryThread.join();
-  printCounters(**device, "stopped: ");
   return 0;
 }
 
@@ -156,6 +204,8 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--scene", opts.scene, "simulated board: render this scene");
   app.add_option("--replay", opts.replay,
                  "simulated board: replay <dir>/<camera-id>_<n>.png instead of rendering");
+  app.add_option("--state", opts.state,
+                 "state directory: the owner's settings (config.json), kept across restarts");
   app.add_option("--fps", opts.fps, "camera frame rate (overrides the board)")
       ->check(CLI::Range(1, 1000));
   app.add_option("--frames", opts.frames, "stop after this many captures (0: run until SIGTERM)");

@@ -57,7 +57,7 @@ TEST(DeviceConfig, BadValuesAreRefusedNamingTheKey) {
   const Case cases[] = {
       {doc(R"("fps": 0)"), "fps", "from 1 to 120"},
       {doc(R"("fps": 12.5)"), "fps", "integer"},
-      {doc(R"("compression": "zip")"), "compression", "rvl, none"},
+      {doc(R"("compression": "zip")"), "compression", "any, rvl, none"},
       {doc(R"("exposure": 3)"), "", "unknown key \"exposure\""},
       {doc(R"("depth_min_m": -1)"), "depth_min_m", "negative"},
       {doc(R"("depth_min_m": 2, "depth_max_m": 1)"), "depth_max_m", "empty"},
@@ -111,9 +111,12 @@ TEST(DeviceConfig, EffectiveSettingsFillInTheBoards) {
   const auto all = parseDeviceConfig(effectiveJson(*config, board), board);
   ASSERT_TRUE(all.has_value());
   EXPECT_EQ(all->fps, 30);  // boards/sim/board.json
-  EXPECT_EQ(all->compression, Compression::kRvl);
+  EXPECT_EQ(all->compression, Compression::kAny);
   EXPECT_EQ(all->depthMinM, 0.0);
   EXPECT_EQ(all->depthMaxM, 2.0);
+  const auto none = parseDeviceConfig(effectiveJson({}, board), board);
+  ASSERT_TRUE(none.has_value());
+  EXPECT_EQ(none->depthMaxM, 6.5535);  // 65535 units of 0.1 mm
   EXPECT_EQ(all->confidenceMin, 1);
   ASSERT_TRUE(all->rig.has_value());
   EXPECT_EQ(toJson(*all->rig), toJson(board.rig));

@@ -17,5 +17,6 @@ void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addConfigCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

@@ -277,4 +277,55 @@ std::expected<RawCapture, std::string> DeviceClient::captureRaw(std::uint32_t pr
   return assembler->take();
 }
 
+std::expected<std::string, std::string> DeviceClient::getConfig(std::chrono::milliseconds timeout) {
+  if (auto sent = send(protocol::encodeEmpty(MessageType::kGetConfig, out_)); !sent) {
+    return Fail(sent.error());
+  }
+  return awaitConfig(timeout, "get-config");
+}
+
+std::expected<std::string, std::string> DeviceClient::setConfig(protocol::SetConfigMode mode,
+                                                                std::string_view json,
+                                                                std::chrono::milliseconds timeout) {
+  std::vector<std::byte> message(protocol::kHeaderBytes + 8 + json.size());
+  if (auto sent = send(protocol::encode(protocol::SetConfig{mode, json}, message)); !sent) {
+    return Fail(sent.error());
+  }
+  return awaitConfig(timeout, "set-config");
+}
+
+std::expected<std::string, std::string> DeviceClient::awaitConfig(std::chrono::milliseconds timeout,
+                                                                  std::string_view request) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    auto message = nextMessage(std::max(left, std::chrono::milliseconds(0)));
+    if (!message) {
+      return Fail(message.error());
+    }
+    if (!message->has_value()) {
+      return Fail("no answer to " + std::string(request) + " within " +
+                  std::to_string(timeout.count()) + " ms");
+    }
+    const auto& [type, payload] = **message;
+    if (type == MessageType::kError) {
+      const auto error = protocol::decodeError(payload);
+      if (error && std::string_view(error->text).find("does not know") != std::string_view::npos) {
+        return Fail("the device's firmware " + info_.firmwareVersion +
+                    " has no settings to change (it does not know " + std::string(request) +
+                    "): update it");
+      }
+      return Fail(deviceError(payload));
+    }
+    if (type == MessageType::kConfig) {
+      const auto config = protocol::decodeConfig(payload);
+      if (!config) {
+        return Fail(std::string("bad config message: ") + config.error().message);
+      }
+      return std::string(config->json);
+    }
+  }
+}
+
 }  // namespace smx::host

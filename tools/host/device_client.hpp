@@ -61,6 +61,13 @@ class DeviceClient {
   // that refuses, or says nothing within `timeout`, is an error saying so.
   [[nodiscard]] std::expected<RawCapture, std::string> captureRaw(
       std::uint32_t projectorsMask, std::chrono::milliseconds timeout);
+  // The settings the device runs with, a stripemux-config/1 document (docs/config.md).
+  [[nodiscard]] std::expected<std::string, std::string> getConfig(
+      std::chrono::milliseconds timeout);
+  // Changes settings: the device checks and stores them, answers with the settings it will run
+  // with, and restarts with them (this connection ends). A refusal names the setting.
+  [[nodiscard]] std::expected<std::string, std::string> setConfig(
+      protocol::SetConfigMode mode, std::string_view json, std::chrono::milliseconds timeout);
   // Bad messages from the device so far (skipped).
   [[nodiscard]] std::uint64_t protocolErrors() const { return parser_->counters().errors; }
   void close() { socket_.close(); }
@@ -69,6 +76,9 @@ class DeviceClient {
   DeviceClient(net::TcpClient socket, std::string address);
   [[nodiscard]] std::expected<void, std::string> send(
       const protocol::ProtocolResult<std::span<const std::byte>>& message);
+  // The config message that answers a get-config or set-config.
+  [[nodiscard]] std::expected<std::string, std::string> awaitConfig(
+      std::chrono::milliseconds timeout, std::string_view request);
   // The next whole message (copied), or nullopt on timeout.
   [[nodiscard]] std::expected<
       std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>>, std::string>

@@ -65,6 +65,10 @@ void Device::onMessage(const protocol::Message& message) {
         refuse(protocol::ErrorCode::kBadRequest, start.error().message);
       } else if (!helloSeen_) {
         refuse(protocol::ErrorCode::kBadRequest, "start-stream before hello");
+      } else if ((options_.compressionsMask & (1U << static_cast<unsigned>(start->compression))) ==
+                 0) {
+        refuse(protocol::ErrorCode::kBadRequest,
+               "start-stream: the device's settings do not allow that compression");
       } else {
         compression_ = start->compression;
         confidence_ = start->confidence;
@@ -102,9 +106,60 @@ void Device::onMessage(const protocol::Message& message) {
       }
       return;
     }
+    case MessageType::kGetConfig:
+      if (!protocol::decodeEmpty(message.payload)) {
+        refuse(protocol::ErrorCode::kBadRequest, "payload on a message that has none");
+      } else if (!helloSeen_) {
+        refuse(protocol::ErrorCode::kBadRequest, "get-config before hello");
+      } else {
+        sendConfig(options_.configJson);
+      }
+      return;
+    case MessageType::kSetConfig:
+      onSetConfig(message);
+      return;
     default:
       refuse(protocol::ErrorCode::kBadRequest, "that message type is not for the device");
       return;
+  }
+}
+
+void Device::sendConfig(std::string_view json) {
+  if (const auto config = protocol::encode(protocol::ConfigMessage{json},
+                                           std::span(control_).subspan(controlSize_))) {
+    controlSize_ += config->size();
+  } else {
+    ++counters_.protocolErrors;  // replies were not read: the host loses this one too
+  }
+}
+
+// Leaves the steady state: parsing and storing settings allocate, and the device restarts.
+void Device::onSetConfig(const protocol::Message& message) {
+  const auto refuse = [&](protocol::ErrorCode code, std::string_view text) {
+    std::array<std::byte, 1024> reply{};
+    const std::string_view cut = text.substr(0, reply.size() - 64);
+    if (const auto error = protocol::encode(protocol::ErrorMessage{code, cut}, reply)) {
+      sendControl(*error);
+    }
+  };
+  const auto request = protocol::decodeSetConfig(message.payload);
+  if (!request) {
+    ++counters_.protocolErrors;
+    refuse(protocol::ErrorCode::kBadRequest, request.error().message);
+  } else if (!helloSeen_) {
+    refuse(protocol::ErrorCode::kBadRequest, "set-config before hello");
+  } else if (!options_.setConfig) {
+    refuse(protocol::ErrorCode::kBadRequest,
+           "set-config: this device keeps no settings (stripemuxd runs without --state)");
+  } else if (restartPending_) {
+    refuse(protocol::ErrorCode::kBusy, "set-config: the device is restarting with new settings");
+  } else if (auto stored = options_.setConfig(*request); !stored) {
+    refuse(protocol::ErrorCode::kBadRequest, "set-config: " + stored.error());
+  } else {
+    streaming_ = false;
+    queue_.clear();
+    sendConfig(*stored);
+    restartPending_ = true;
   }
 }
 
@@ -187,6 +242,10 @@ void Device::pumpSend(std::int64_t nowNs) {
 void Device::serviceNetwork(std::int64_t timeoutNs) {
   hal::Link& link = hal_.link;
   if (!link.connected()) {
+    if (restartPending_) {
+      restartDue_ = true;  // the host left before its answer was out; the settings are stored
+      return;
+    }
     if (hadClient_) {
       dropConnection();  // the link noticed first that the host left
       hadClient_ = false;
@@ -247,6 +306,9 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     onMessage(*message);
   }
   pumpSend(now);
+  if (restartPending_ && controlSize_ == 0 && sending_.empty()) {
+    restartDue_ = true;  // the answer is out: the host knows the settings are stored
+  }
   if (idle(now)) {
     ++counters_.idleDisconnects;
     dropConnection();
@@ -265,7 +327,7 @@ bool Device::idle(std::int64_t nowNs) const {
 }
 
 void Device::runNetwork(const std::atomic<bool>& stop) {
-  while (!stop) {
+  while (!stop && !restartDue_) {
     serviceNetwork(kNetworkTickNs);
   }
   if (hal_.link.connected()) {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "smx/config/device_config.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/device/device.hpp"
 
@@ -10,6 +11,8 @@ namespace smx::device {
 namespace {
 using Fail = std::unexpected<std::string>;
 constexpr std::size_t kControlBytes = 4096;  // replies besides the capabilities
+// A set-config's settings, and the config message that answers it.
+constexpr std::size_t kConfigBytes = config::kDeviceConfigMaxBytes + 64;
 }  // namespace
 
 Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options)
@@ -24,7 +27,7 @@ Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& op
       queue_(options.queueSlots + board.rig.cameras.size() + 1,
              protocol::rangeFrameBound(board.rig.cameras.front().width,
                                        board.rig.cameras.front().height, true)),
-      parser_(kControlBytes) {}
+      parser_(kConfigBytes) {}
 
 Device::~Device() = default;
 
@@ -32,6 +35,10 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
                                                                    hal::Hal hal,
                                                                    const DeviceOptions& options) {
   const algo::Rig& rig = board.rig;
+  if (options.compressionsMask == 0 || options.configJson.size() > kConfigBytes) {
+    return Fail("device options: no compression allowed, or settings beyond " +
+                std::to_string(kConfigBytes) + " bytes");
+  }
   if (hal.cameras.size() != rig.cameras.size() || rig.cameras.empty()) {
     return Fail("the board has " + std::to_string(hal.cameras.size()) +
                 " cameras but its rig has " + std::to_string(rig.cameras.size()));
@@ -90,7 +97,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
       .width = static_cast<std::uint16_t>(rig.cameras.front().width),
       .height = static_cast<std::uint16_t>(rig.cameras.front().height),
       .fps = static_cast<std::uint16_t>(board.config.cameras.front().format.fps),
-      .compressionsMask = (1U << 0U) | (1U << 1U),
+      .compressionsMask = options.compressionsMask,
       .rigJson = rigJson};
   device->capabilities_.resize(protocol::kHeaderBytes + 1024 + rigJson.size());
   const auto encoded = protocol::encode(caps, device->capabilities_);
@@ -98,7 +105,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
     return Fail(std::string("capabilities: ") + encoded.error().message);
   }
   device->capabilities_.resize(encoded->size());
-  device->control_.resize(device->capabilities_.size() + kControlBytes);
+  device->control_.resize(device->capabilities_.size() + kControlBytes + 2 * kConfigBytes);
   // Every camera's bands of one raw capture, or the error that replaces them.
   device->raw_.resize(std::max<std::size_t>(
       kControlBytes, rig.cameras.size() * protocol::rawFrameBound(rig.cameras.front().width,

@@ -1,6 +1,8 @@
 #include "smx/config/device_config.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <exception>
 #include <nlohmann/json.hpp>
 #include <utility>
@@ -19,7 +21,7 @@ constexpr std::array<std::string_view, 6> kSettingKeys = {
     "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
 constexpr std::array<std::string_view, 7> kTopKeys = {
     "format", "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
-constexpr std::array<std::string_view, 2> kCompressions = {"rvl", "none"};
+constexpr std::array<std::string_view, 3> kCompressions = {"any", "rvl", "none"};
 
 constexpr std::array<FormatHint, 2> kOtherFormats = {
     {{"stripemux-rig/", " (this is a rig.json; a configuration holds it under \"rig\")"},
@@ -126,7 +128,8 @@ std::expected<DeviceConfig, FieldError> parseImpl(std::string_view text, const B
         std::ranges::find(kCompressions, v->get_ref<const std::string&>()) == kCompressions.end()) {
       r.fail("compression", "must be one of: " + joined(kCompressions) + ", got " + describe(*v));
     } else {
-      out.compression = *v == "rvl" ? Compression::kRvl : Compression::kNone;
+      const auto at = std::ranges::find(kCompressions, v->get_ref<const std::string&>());
+      out.compression = static_cast<Compression>(at - kCompressions.begin());
     }
   }
   readDepthWindow(r, doc, board, stored, out);
@@ -149,7 +152,7 @@ Json settingsJson(const DeviceConfig& c) {
     doc["fps"] = *c.fps;
   }
   if (c.compression) {
-    doc["compression"] = *c.compression == Compression::kRvl ? "rvl" : "none";
+    doc["compression"] = kCompressions.at(static_cast<std::size_t>(*c.compression));
   }
   if (c.depthMinM) {
     doc["depth_min_m"] = *c.depthMinM;
@@ -182,6 +185,20 @@ std::expected<DeviceConfig, FieldError> parseDeviceConfig(std::string_view text,
   }
 }
 
+std::expected<DeviceConfig, FieldError> loadDeviceConfig(const std::filesystem::path& file,
+                                                         const Board& board) {
+  try {
+    auto text = readDocumentFile(file, kConfigDocument);
+    if (!text) {
+      return std::unexpected(text.error());
+    }
+    return parseDeviceConfig(*text, board);
+  } catch (const std::exception& e) {
+    return std::unexpected(
+        FieldError{{}, std::string("cannot read the configuration: ") + e.what()});
+  }
+}
+
 DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change) {
   const auto take = [](auto& into, const auto& from) {
     if (from) {
@@ -204,9 +221,11 @@ std::string toJson(const DeviceConfig& config) {
 std::string effectiveJson(const DeviceConfig& config, const Board& board) {
   DeviceConfig all = config;
   all.fps = config.fps.value_or(board.config.cameras.front().format.fps);
-  all.compression = config.compression.value_or(Compression::kRvl);
+  all.compression = config.compression.value_or(Compression::kAny);
   all.depthMinM = config.depthMinM.value_or(0.0);
-  all.depthMaxM = config.depthMaxM.value_or(algo::maxStoredDepthM(board.config.depthUnitM));
+  // To the micrometre: 65535 units of 0.1 mm are 6.5535 m, not 6.5535000000000005.
+  all.depthMaxM = config.depthMaxM.value_or(
+      std::round(algo::maxStoredDepthM(board.config.depthUnitM) * 1e6) / 1e6);
   all.confidenceMin = config.confidenceMin.value_or(1);
   all.rig = config.rig.value_or(board.rig);
   return toJson(all);

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <expected>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,7 +33,14 @@ struct DeviceOptions {
   // Long enough for a person between two commands of a host program or a slow disk write on
   // the host; short enough that a forgotten or vanished host frees the scanner in half a minute.
   std::int64_t idleTimeoutNs = 30'000'000'000;
-  algo::PipelineOptions pipeline;  // depthUnitM is taken from the board
+  algo::PipelineOptions pipeline;                           // depthUnitM is taken from the board
+  std::uint8_t compressionsMask = (1U << 0U) | (1U << 1U);  // what start-stream may ask for
+  // The settings the device runs with (stripemux-config/1), the answer to get-config.
+  std::string configJson;
+  // Checks and stores a set-config's change and returns the settings the device will run with
+  // (or why not); the device then restarts with them (restartDue()). Runs on the network
+  // thread; unset: set-config is refused.
+  std::function<std::expected<std::string, std::string>(const protocol::SetConfig&)> setConfig;
 };
 
 // Counters, readable from any thread while the loops run.
@@ -80,6 +88,9 @@ class Device {
   // connection only, the rest since start-up (docs/protocol.md, message 7).
   [[nodiscard]] protocol::Statistics statisticsForHost() const;
   [[nodiscard]] bool streaming() const { return streaming_; }
+  // A set-config was stored and its answer sent: the owner of the loops stops them and creates
+  // the device again with the new settings. runNetwork() returns when this turns true.
+  [[nodiscard]] bool restartDue() const { return restartDue_; }
   // A host's capture-raw waits for the capture loop.
   [[nodiscard]] bool rawCaptureRequested() const { return rawState_ == RawState::kRequested; }
   [[nodiscard]] std::size_t arenaBytes() const;
@@ -100,6 +111,8 @@ class Device {
   std::size_t captureRaw(std::uint32_t mask);
   std::size_t rawError(std::string_view what, const hal::HalError& error);
   void onMessage(const protocol::Message& message);
+  void onSetConfig(const protocol::Message& message);
+  void sendConfig(std::string_view json);
   void sendControl(std::span<const std::byte> message);
   void dropConnection();
   void pumpSend(std::int64_t nowNs);
@@ -120,6 +133,7 @@ class Device {
   std::atomic<bool> streaming_ = false;
   std::atomic<protocol::Compression> compression_ = protocol::Compression::kRvl;
   std::atomic<bool> confidence_ = false;  // the host asked for the confidence planes
+  std::atomic<bool> restartDue_ = false;
 
   // Raw capture: the network thread takes a request (kIdle → kRequested), the capture loop
   // serves it (→ kCapturing → kReady), the network thread sends raw_ (→ kSending → kIdle).
@@ -140,6 +154,7 @@ class Device {
   bool sendingRaw_ = false;
   std::size_t sent_ = 0;
   bool helloSeen_ = false;
+  bool restartPending_ = false;  // a set-config was stored; its answer is on the way
   bool hadClient_ = false;
   std::int64_t lastReceivedNs_ = 0;  // the host last sent bytes
   std::int64_t lastSentNs_ = 0;      // the socket last took bytes, or nothing was waiting

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <expected>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,7 +20,8 @@ inline constexpr std::string_view kDeviceConfigFormat = "stripemux-config/1";
 // Bounds the request and the stored file: a rig.json is a few KiB.
 inline constexpr std::size_t kDeviceConfigMaxBytes = std::size_t{1} << 16U;
 
-enum class Compression : std::uint8_t { kRvl, kNone };
+// What range frames may travel as: the host picks from `kAny` (RVL unless told otherwise).
+enum class Compression : std::uint8_t { kAny, kRvl, kNone };
 
 struct DeviceConfig {
   std::optional<int> fps;                  // camera frame rate, 1…120
@@ -38,6 +40,10 @@ struct DeviceConfig {
 // can hold with min < max once combined with `stored` (the settings it would be merged with).
 [[nodiscard]] std::expected<DeviceConfig, FieldError> parseDeviceConfig(
     std::string_view text, const Board& board, const DeviceConfig& stored = {});
+
+// Reads `file` and parses it against `board`; an unreadable file is an error with no field.
+[[nodiscard]] std::expected<DeviceConfig, FieldError> loadDeviceConfig(
+    const std::filesystem::path& file, const Board& board);
 
 // `stored` with every setting `change` has replaced.
 [[nodiscard]] DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change);

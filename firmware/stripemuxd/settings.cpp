@@ -1,0 +1,156 @@
+#include "settings.hpp"
+
+#include <system_error>
+#include <utility>
+
+#include "smx/algo/camera_pipeline.hpp"
+#include "smx/device/state_file.hpp"
+
+namespace smx::firmware {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kConfigFile = "config.json";
+
+algo::PipelineOptions pipelineOptions(const config::DeviceConfig& c, const config::Board& board,
+                                      algo::PipelineOptions base) {
+  base.depthUnitM = board.config.depthUnitM;
+  base.minDepthM = c.depthMinM.value_or(0.0);
+  base.maxDepthM = c.depthMaxM.value_or(base.maxDepthM);
+  base.minConfidence = c.confidenceMin.value_or(1);
+  return base;
+}
+
+// What Device::create() would refuse about the settings' rig and window, before they are stored.
+std::expected<void, std::string> checkPipelines(const config::DeviceConfig& c,
+                                                const config::Board& physical) {
+  const config::Board board = config::appliedTo(c, physical);
+  const auto options = pipelineOptions(c, board, {});
+  for (std::size_t i = 0; i < board.rig.cameras.size(); ++i) {
+    if (const auto setup = algo::prepareCameraPipeline(board.rig, static_cast<int>(i), options);
+        !setup) {
+      return std::unexpected("the device cannot decode camera " + board.rig.cameras[i].id +
+                             " with these settings: " + setup.error());
+    }
+  }
+  return {};
+}
+
+std::string fieldMessage(const config::FieldError& e) {
+  return config::errorMessage("", e.field, e.problem);
+}
+
+}  // namespace
+
+std::expected<Settings, std::string> Settings::load(const fs::path& stateDir, config::Board board,
+                                                    std::string& report) {
+  Settings settings(stateDir, std::move(board));
+  if (stateDir.empty()) {
+    return settings;
+  }
+  std::error_code ec;
+  if (!fs::is_directory(stateDir, ec)) {
+    return std::unexpected("state directory " + stateDir.string() + " is not a directory");
+  }
+  const fs::path file = stateDir / kConfigFile;
+  if (device::removeInterruptedWrite(file)) {
+    report += "removed " + file.string() + ".tmp, left by an interrupted write\n";
+  }
+  if (!fs::exists(file, ec)) {
+    return settings;
+  }
+  // Written whole or not at all, so a bad file is one the board no longer accepts (another
+  // board.json, a hand edit): the device still starts, with the board's settings.
+  auto stored = config::loadDeviceConfig(file, settings.board_);
+  std::expected<void, std::string> fits =
+      stored ? checkPipelines(*stored, settings.board_) : std::expected<void, std::string>{};
+  if (!stored || !fits) {
+    const fs::path rejected = stateDir / "config.json.rejected";
+    fs::rename(file, rejected, ec);
+    report += file.string() + ": " + (stored ? fits.error() : fieldMessage(stored.error())) +
+              "; running with the board's settings (the file is kept as " + rejected.string() +
+              ")\n";
+    return settings;
+  }
+  settings.stored_ = *stored;
+  settings.previous_ = *stored;
+  return settings;
+}
+
+device::DeviceOptions Settings::deviceOptions(device::DeviceOptions base) const {
+  const config::Board running = board();
+  base.pipeline = pipelineOptions(stored_, running, base.pipeline);
+  // Bit c: protocol::Compression c (0 none, 1 RVL).
+  switch (stored_.compression.value_or(config::Compression::kAny)) {
+    case config::Compression::kRvl:
+      base.compressionsMask = 1U << 1U;
+      break;
+    case config::Compression::kNone:
+      base.compressionsMask = 1U << 0U;
+      break;
+    case config::Compression::kAny:
+      break;
+  }
+  base.configJson = config::effectiveJson(stored_, board_);
+  return base;
+}
+
+std::expected<std::string, std::string> Settings::change(const protocol::SetConfig& request) {
+  if (stateDir_.empty()) {
+    return std::unexpected("this device keeps no settings (stripemuxd runs without --state)");
+  }
+  const bool reset = request.mode == protocol::SetConfigMode::kReset;
+  const config::DeviceConfig base = reset ? config::DeviceConfig{} : stored_;
+  config::DeviceConfig change;
+  if (!(reset && request.json.empty())) {
+    auto parsed = config::parseDeviceConfig(request.json, board_, base);
+    if (!parsed) {
+      return std::unexpected(fieldMessage(parsed.error()));
+    }
+    change = std::move(*parsed);
+  }
+  const config::DeviceConfig next = config::merged(base, change);
+  if (auto fits = checkPipelines(next, board_); !fits) {
+    return std::unexpected(fits.error());
+  }
+  if (auto stored = store(next); !stored) {
+    return std::unexpected(stored.error());
+  }
+  return config::effectiveJson(stored_, board_);
+}
+
+std::expected<void, std::string> Settings::revert() {
+  return store(previous_);
+}
+
+std::expected<void, std::string> Settings::store(const config::DeviceConfig& next) {
+  if (auto written =
+          device::writeStateFile(stateDir_ / kConfigFile, config::toJson(next), "config");
+      !written) {
+    return std::unexpected("the settings were not stored: " + written.error());
+  }
+  previous_ = std::exchange(stored_, next);
+  return {};
+}
+
+std::string Settings::describe() const {
+  std::string keys;
+  const auto add = [&](bool set, const char* key) {
+    if (set) {
+      keys += (keys.empty() ? "" : ", ") + std::string(key);
+    }
+  };
+  add(stored_.fps.has_value(), "fps");
+  add(stored_.compression.has_value(), "compression");
+  add(stored_.depthMinM.has_value(), "depth_min_m");
+  add(stored_.depthMaxM.has_value(), "depth_max_m");
+  add(stored_.confidenceMin.has_value(), "confidence_min");
+  add(stored_.rig.has_value(), "rig");
+  if (keys.empty()) {
+    return stateDir_.empty() ? "the board's (no state directory)" : "the board's";
+  }
+  return (stateDir_ / kConfigFile).string() + " (" + keys + ")";
+}
+
+}  // namespace smx::firmware
