@@ -208,8 +208,23 @@ def range_seeds():
     write("protocol", "sealed_raw_band_past_height.bin", b"\x90" + record(11, raw_band(2, 2)[:-15]))
 
 
+def config_seeds():
+    """Settings for the simulated board: each key alone, all of them with its rig, and near-valid
+    ones (a window with min above max, a rig cut short)."""
+    rig = json.loads((SRC / "boards/sim/rig_2proj_2cam.json").read_text())
+    head = {"format": "stripemux-config/1"}
+    write("config", "empty.json", json.dumps(head))
+    write("config", "fps.json", json.dumps({**head, "fps": 12}))
+    write("config", "window.json", json.dumps({**head, "depth_min_m": 0.3, "depth_max_m": 1.5,
+                                               "confidence_min": 100}))
+    write("config", "window_empty.json", json.dumps({**head, "depth_min_m": 2, "depth_max_m": 1}))
+    write("config", "all.json", json.dumps({**head, "fps": 7, "compression": "none",
+                                            "depth_max_m": 2, "rig": rig}, indent=1))
+    write("config", "rig_cut.json", json.dumps({**head, "rig": rig})[:900])
+
+
 def main():
-    for target in ("protocol", "rig", "board", "scene", "png", "range_frame"):
+    for target in ("protocol", "rig", "board", "scene", "png", "range_frame", "config"):
         shutil.rmtree(CORPUS / target, ignore_errors=True)
         (CORPUS / target).mkdir(parents=True)
     FILES.mkdir(exist_ok=True)
@@ -218,6 +233,7 @@ def main():
     png_seeds()
     json_seeds()
     range_seeds()
+    config_seeds()
 
 
 if __name__ == "__main__":

@@ -65,7 +65,7 @@ std::expected<std::string, std::string> readSmallFile(const fs::path& path) {
                            " bytes; settings are at most " +
                            std::to_string(config::kDeviceConfigMaxBytes) + " bytes");
   }
-  std::ifstream in(path, std::ios::binary);
+  const std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
   if (!in) {

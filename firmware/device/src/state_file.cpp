@@ -6,7 +6,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
-#include <cstring>
+#include <system_error>
 
 #include "smx/hal/unique_fd.hpp"
 
@@ -16,7 +16,8 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string systemError(const std::string& what, const fs::path& path) {
-  return what + " " + path.string() + ": " + std::strerror(errno);
+  return what + " " + path.string() + ": " +
+         std::error_code(errno, std::generic_category()).message();
 }
 
 fs::path tempOf(const fs::path& file) {

@@ -128,7 +128,7 @@ std::expected<DeviceConfig, FieldError> parseImpl(std::string_view text, const B
         std::ranges::find(kCompressions, v->get_ref<const std::string&>()) == kCompressions.end()) {
       r.fail("compression", "must be one of: " + joined(kCompressions) + ", got " + describe(*v));
     } else {
-      const auto at = std::ranges::find(kCompressions, v->get_ref<const std::string&>());
+      const auto* const at = std::ranges::find(kCompressions, v->get_ref<const std::string&>());
       out.compression = static_cast<Compression>(at - kCompressions.begin());
     }
   }
