@@ -304,11 +304,12 @@ std::expected<std::string, std::string> DeviceClient::awaitConfig(std::chrono::m
     if (!message) {
       return Fail(message.error());
     }
-    if (!message->has_value()) {
+    const auto& got = *message;
+    if (!got.has_value()) {
       return Fail("no answer to " + std::string(request) + " within " +
                   std::to_string(timeout.count()) + " ms");
     }
-    const auto& [type, payload] = **message;
+    const auto& [type, payload] = *got;
     if (type == MessageType::kError) {
       const auto error = protocol::decodeError(payload);
       if (error && std::string_view(error->text).find("does not know") != std::string_view::npos) {
