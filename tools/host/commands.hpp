@@ -17,5 +17,8 @@ void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addKeygenCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host
