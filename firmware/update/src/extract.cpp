@@ -2,7 +2,7 @@
 
 #include <cerrno>
 #include <cstdio>
-#include <cstring>
+#include <ranges>
 #include <set>
 #include <string>
 #include <system_error>
@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 
 std::unexpected<UpdateError> ioFail(const fs::path& path, const char* what) {
   return std::unexpected(
-      UpdateError{UpdateReason::kIo, path.string() + ": " + what + ": " + std::strerror(errno)});
+      UpdateError{UpdateReason::kIo,
+                  path.string() + ": " + what + ": " + std::generic_category().message(errno)});
 }
 
 // Creates the file's directories below root (names are checked: no "..", no leading '/') and
@@ -61,8 +62,8 @@ std::expected<void, UpdateError> extractBundle(const VerifiedBundle& bundle,
     }
   }
   // Deepest first, so that each directory's entries are durable before its parent's.
-  for (auto it = dirs.rbegin(); it != dirs.rend(); ++it) {
-    if (auto synced = syncDirectory(*it); !synced) {
+  for (const auto& dir : std::views::reverse(dirs)) {
+    if (auto synced = syncDirectory(dir); !synced) {
       return synced;
     }
   }

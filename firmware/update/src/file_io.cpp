@@ -5,7 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstring>
+#include <system_error>
 #include <utility>
 
 namespace smx::update {
@@ -14,7 +14,8 @@ namespace {
 namespace fs = std::filesystem;
 
 UpdateError ioError(const fs::path& path, const char* what) {
-  return {UpdateReason::kIo, path.string() + ": " + what + ": " + std::strerror(errno)};
+  return {UpdateReason::kIo,
+          path.string() + ": " + what + ": " + std::generic_category().message(errno)};
 }
 
 // Owns a file descriptor for the length of one function.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <ranges>
 #include <vector>
 
 #include "base64.hpp"
@@ -71,9 +72,9 @@ KeyPair generateKeyPair() {
 
 std::string keyIdHex(const KeyId& id) {
   std::string hex;
-  for (auto it = id.rbegin(); it != id.rend(); ++it) {
+  for (const std::uint8_t byte : std::views::reverse(id)) {
     std::array<char, 3> digits{};
-    std::snprintf(digits.data(), digits.size(), "%02X", *it);
+    std::snprintf(digits.data(), digits.size(), "%02X", byte);
     hex += digits.data();
   }
   return hex;

@@ -73,7 +73,7 @@ std::expected<BundleFile, UpdateError> parseFile(const Json& entry, const std::s
   file.size = size.get<std::uint64_t>();
   const Json& mode = entry["mode"];
   if (!mode.is_string() || (mode != "0644" && mode != "0755")) {
-    return bad(where + ".mode", "not \"0644\" or \"0755\"");
+    return bad(where + ".mode", R"(not "0644" or "0755")");
   }
   file.mode = mode == "0755" ? 0755 : 0644;
   const Json& hash = entry["blake2b"];
@@ -96,9 +96,10 @@ std::expected<void, UpdateError> checkNamesDistinct(const std::vector<BundleFile
     }
   }
   for (const auto& f : files) {
-    for (auto slash = f.name.find('/'); slash != std::string::npos;
-         slash = f.name.find('/', slash + 1)) {
-      if (names.contains(std::string_view(f.name).substr(0, slash))) {
+    const std::string_view name = f.name;
+    for (auto slash = name.find('/'); slash != std::string_view::npos;
+         slash = name.find('/', slash + 1)) {
+      if (names.contains(name.substr(0, slash))) {
         return bad("files", "\"" + f.name.substr(0, slash) + "\" is a file and a directory",
                    UpdateReason::kBadName);
       }

@@ -77,7 +77,7 @@ std::expected<KeyId, UpdateError> verify(std::span<const std::byte> data,
   const auto encoded = takeLine(rest);
   const auto comment = takeLine(rest);
   const auto encodedGlobal = takeLine(rest);
-  if (!encodedGlobal || !rest.empty()) {
+  if (!untrusted || !encoded || !comment || !encodedGlobal || !rest.empty()) {
     return std::unexpected(malformed("not four lines"));
   }
   if (*untrusted != kUntrustedComment) {

@@ -9,8 +9,8 @@ namespace smx::update {
 void initSodium() {
   // Thread-safe once; fails only when the system has no random source, which no key can do
   // without.
-  static const bool ok = sodium_init() >= 0;
-  if (!ok) {
+  static const bool kReady = sodium_init() >= 0;
+  if (!kReady) {
     std::abort();
   }
 }

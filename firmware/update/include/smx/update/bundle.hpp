@@ -21,7 +21,7 @@ namespace smx::update {
 inline constexpr std::string_view kBundleFormat = "stripemux-bundle/1";
 inline constexpr std::size_t kHeaderSize = 24;
 inline constexpr std::size_t kTrailerSize = 12;
-inline constexpr std::size_t kMaxManifestSize = 64 * 1024;
+inline constexpr std::size_t kMaxManifestSize = std::size_t{64} * 1024;
 inline constexpr std::size_t kMaxFiles = 256;
 inline constexpr std::uint64_t kMaxPayloadSize = 256ULL * 1024 * 1024;
 inline constexpr std::size_t kMaxSignatureSize = 4096;
