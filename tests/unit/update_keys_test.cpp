@@ -74,6 +74,13 @@ TEST_F(UpdateKeys, ASecretKeyWithAWrongChecksumIsRefused) {
   EXPECT_NE(key.error().message.find("k.key"), std::string::npos);
 }
 
+TEST_F(UpdateKeys, KeyIdsPrintAsMinisignPrintsThem) {
+  // Ids and names from key files minisign 0.11 wrote ("minisign public key 748CD41B5481321").
+  EXPECT_EQ(keyIdHex({0x21, 0x13, 0x48, 0xb5, 0x41, 0xcd, 0x48, 0x07}), "748CD41B5481321");
+  EXPECT_EQ(keyIdHex({0x63, 0xc5, 0x94, 0x02, 0x44, 0x03, 0x3e, 0x00}), "3E03440294C563");
+  EXPECT_EQ(keyIdHex({}), "0");
+}
+
 TEST_F(UpdateKeys, MinisignVerifiesOurSignature) {
   if (!haveMinisign()) {
     GTEST_SKIP() << "minisign is not installed (tools/install-deps installs it)";

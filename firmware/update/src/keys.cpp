@@ -77,7 +77,9 @@ std::string keyIdHex(const KeyId& id) {
     std::snprintf(digits.data(), digits.size(), "%02X", byte);
     hex += digits.data();
   }
-  return hex;
+  // minisign prints it with PRIX64: no leading zeros.
+  const auto first = std::min(hex.find_first_not_of('0'), hex.size() - 1);
+  return hex.substr(first);
 }
 
 std::string publicKeyLine(const PublicKey& key) {

@@ -36,7 +36,8 @@ struct KeyPair {
 // The same seed gives the same pair (test keys, fuzz seeds); the id is taken from the seed.
 [[nodiscard]] KeyPair keyPairFromSeed(std::span<const std::uint8_t, 32> seed);
 
-// As minisign prints it: the id read as a little-endian 64-bit number, upper-case hex.
+// As minisign prints it: the id read as a little-endian 64-bit number, upper-case hex without
+// leading zeros.
 [[nodiscard]] std::string keyIdHex(const KeyId& id);
 
 // The public key's "RW…" line alone, and the two-line file minisign writes.
