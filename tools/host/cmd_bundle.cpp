@@ -84,15 +84,14 @@ std::expected<std::vector<update::BundleInput>, update::UpdateError> readTree(co
   std::sort(paths.begin(), paths.end());
   std::vector<update::BundleInput> files;
   for (const auto& path : paths) {
-    const auto text = update::readFile(path, update::kMaxPayloadSize);
-    if (!text) {
-      return std::unexpected(text.error());
+    auto bytes = update::readFile(path, update::kMaxPayloadSize);
+    if (!bytes) {
+      return std::unexpected(bytes.error());
     }
     const auto perms = fs::status(path, ec).permissions();
     const bool executable = (perms & fs::perms::owner_exec) != fs::perms::none;
-    const auto bytes = update::asBytes(*text);
     files.push_back({path.lexically_relative(dir).generic_string(), executable ? 0755U : 0644U,
-                     std::vector<std::byte>(bytes.begin(), bytes.end())});
+                     std::move(*bytes)});
   }
   return files;
 }

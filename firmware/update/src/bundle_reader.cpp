@@ -151,12 +151,11 @@ std::expected<VerifiedBundle, UpdateError> verifyBundle(std::vector<std::byte> b
 std::expected<VerifiedBundle, UpdateError> verifyBundleFile(const std::filesystem::path& path,
                                                             std::span<const PublicKey> trusted,
                                                             const Expectations& expect) {
-  auto text = readFile(path, kMaxBundleSize);
-  if (!text) {
-    return std::unexpected(text.error());
+  auto bytes = readFile(path, kMaxBundleSize);
+  if (!bytes) {
+    return std::unexpected(bytes.error());
   }
-  const auto bytes = asBytes(*text);
-  auto verified = verifyBundle(std::vector<std::byte>(bytes.begin(), bytes.end()), trusted, expect);
+  auto verified = verifyBundle(std::move(*bytes), trusted, expect);
   if (!verified) {
     return std::unexpected(
         UpdateError{verified.error().reason, path.string() + ": " + verified.error().message});

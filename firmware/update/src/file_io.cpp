@@ -108,8 +108,10 @@ std::expected<void, UpdateError> writeFileAtomic(const fs::path& path,
   return syncDirectory(dir);
 }
 
-std::expected<std::string, UpdateError> readFile(const fs::path& path, std::size_t maxBytes) {
-  const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+std::expected<std::vector<std::byte>, UpdateError> readFile(const fs::path& path,
+                                                            std::size_t maxBytes) {
+  // O_NONBLOCK: a FIFO in place of the file must not hang the open; it is refused below.
+  const Fd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   struct stat st {};
   if (fd.get() < 0 || ::fstat(fd.get(), &st) != 0) {
     return std::unexpected(ioError(path, "open"));
@@ -123,10 +125,10 @@ std::expected<std::string, UpdateError> readFile(const fs::path& path, std::size
         UpdateReason::kTooLarge, path.string() + ": " + std::to_string(st.st_size) +
                                      " bytes, more than the limit of " + std::to_string(maxBytes)});
   }
-  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  std::vector<std::byte> bytes(static_cast<std::size_t>(st.st_size));
   std::size_t done = 0;
-  while (done < text.size()) {
-    const auto n = ::read(fd.get(), text.data() + done, text.size() - done);
+  while (done < bytes.size()) {
+    const auto n = ::read(fd.get(), bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) {
       continue;
     }
@@ -134,12 +136,12 @@ std::expected<std::string, UpdateError> readFile(const fs::path& path, std::size
       return std::unexpected(ioError(path, "read"));
     }
     if (n == 0) {
-      text.resize(done);  // shrank while being read: what is there is what is checked
+      bytes.resize(done);  // shrank while being read: what is there is what is checked
       break;
     }
     done += static_cast<std::size_t>(n);
   }
-  return text;
+  return bytes;
 }
 
 std::span<const std::byte> asBytes(const std::string& text) {

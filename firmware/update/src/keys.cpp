@@ -148,20 +148,22 @@ std::expected<SecretKey, UpdateError> parseSecretKey(std::string_view text,
 }
 
 std::expected<PublicKey, UpdateError> readPublicKeyFile(const std::filesystem::path& path) {
-  const auto text = readFile(path, kMaxKeyFile);
-  if (!text) {
-    return std::unexpected(text.error());
+  const auto bytes = readFile(path, kMaxKeyFile);
+  if (!bytes) {
+    return std::unexpected(bytes.error());
   }
-  return parsePublicKey(*text, path.string());
+  return parsePublicKey(
+      std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()), path.string());
 }
 
 std::expected<SecretKey, UpdateError> readSecretKeyFile(const std::filesystem::path& path) {
-  auto text = readFile(path, kMaxKeyFile);
-  if (!text) {
-    return std::unexpected(text.error());
+  auto bytes = readFile(path, kMaxKeyFile);
+  if (!bytes) {
+    return std::unexpected(bytes.error());
   }
-  auto key = parseSecretKey(*text, path.string());
-  sodium_memzero(text->data(), text->size());
+  auto key = parseSecretKey(
+      std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()), path.string());
+  sodium_memzero(bytes->data(), bytes->size());
   return key;
 }
 

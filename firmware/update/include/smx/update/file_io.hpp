@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "smx/update/update_error.hpp"
 
@@ -25,8 +26,8 @@ enum class Replace { kAllow, kRefuse };
 [[nodiscard]] std::expected<void, UpdateError> syncDirectory(const std::filesystem::path& dir);
 
 // The whole file, refused (kTooLarge) before reading when it is larger than maxBytes.
-[[nodiscard]] std::expected<std::string, UpdateError> readFile(const std::filesystem::path& path,
-                                                               std::size_t maxBytes);
+[[nodiscard]] std::expected<std::vector<std::byte>, UpdateError> readFile(
+    const std::filesystem::path& path, std::size_t maxBytes);
 
 [[nodiscard]] std::span<const std::byte> asBytes(const std::string& text);
 
