@@ -5,7 +5,11 @@ rigs and scenes or made here, and near-valid ones (a field cut short, a size cla
 there). Deterministic; run it again after a format changes and commit what it writes.
 
     tests/fuzz/make_seeds.py
+
+The bundle seeds are signed with Python's `cryptography` (Debian: python3-cryptography).
 """
+import base64
+import hashlib
 import json
 import pathlib
 import shutil
@@ -223,8 +227,60 @@ def config_seeds():
     write("config", "rig_cut.json", json.dumps({**head, "rig": rig})[:900])
 
 
+# The fuzzer's trusted test key (bundle_fuzz.cpp): Ed25519 from the seed of 32 bytes of 1, its id
+# the first 8 bytes of BLAKE2b-256 of the seed, as smx::update::keyPairFromSeed makes it.
+BUNDLE_KEY_SEED = bytes([1] * 32)
+
+
+def bundle(manifest, payload, seed=BUNDLE_KEY_SEED):
+    """A stripemux-bundle/1 file (docs/update.md): header, manifest, payload, signature, trailer."""
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+    key = Ed25519PrivateKey.from_private_bytes(seed)
+    key_id = hashlib.blake2b(seed, digest_size=32).digest()[:8]
+    manifest = manifest.encode()
+    signed = b"SMXBNDL1" + struct.pack("<IIQ", len(manifest), 0, len(payload)) + manifest + payload
+    signature = key.sign(hashlib.blake2b(signed).digest())
+    comment = b"stripemux-bundle/1"
+    text = (b"untrusted comment: stripemux signature\n" +
+            base64.b64encode(b"ED" + key_id + signature) + b"\ntrusted comment: " + comment +
+            b"\n" + base64.b64encode(key.sign(signature + comment)) + b"\n")
+    return signed + text + struct.pack("<I", len(text)) + b"SMXSIGN1"
+
+
+def manifest(files, version="1.2.3", boards=("sim",), allow_downgrade=False):
+    return json.dumps({"format": "stripemux-bundle/1", "version": version, "boards": list(boards),
+                       "allow_downgrade": allow_downgrade,
+                       "files": [{"name": name, "size": len(data), "mode": mode,
+                                  "blake2b": hashlib.blake2b(data, digest_size=32).hexdigest()}
+                                 for name, mode, data in files]}, indent=1)
+
+
+def bundle_seeds():
+    files = [("bin/stripemuxd", "0755", b"#!/bin/sh\necho firmware\n"),
+             ("boards/sim/board.json", "0644", b'{"format": "stripemux-board/1"}\n')]
+    payload = b"".join(data for _, _, data in files)
+    whole = bundle(manifest(files), payload)
+    write("bundle", "valid_sim.bundle", whole)
+    write("bundle", "valid_downgrade.bundle",
+          bundle(manifest(files, "0.9.0", ("rpi4", "sim"), True), payload))
+    write("bundle", "empty.bundle", bundle(manifest([]), b""))
+    # Near-valid: cut short, a signed byte changed, another key, another board.
+    write("bundle", "near_truncated.bundle", whole[:-40])
+    changed = bytearray(whole)
+    changed[30] ^= 1
+    write("bundle", "near_bad_signature.bundle", bytes(changed))
+    write("bundle", "near_other_key.bundle", bundle(manifest(files), payload, bytes([2] * 32)))
+    write("bundle", "near_other_board.bundle", bundle(manifest(files, boards=("rpi4",)), payload))
+    # Manifests the fuzzer seals with the test key itself: "MANIFEST\0PAYLOAD".
+    write("bundle", "manifest_valid.txt", manifest(files).encode() + b"\0" + payload)
+    write("bundle", "manifest_hostile_name.txt",
+          manifest([("../escape", "0644", b"x")]).encode() + b"\0x")
+    write("bundle", "manifest_file_and_dir.txt",
+          manifest([("a", "0644", b"x"), ("a/b", "0644", b"y")]).encode() + b"\0xy")
+
+
 def main():
-    for target in ("protocol", "rig", "board", "scene", "png", "range_frame", "config"):
+    for target in ("protocol", "rig", "board", "scene", "png", "range_frame", "config", "bundle"):
         shutil.rmtree(CORPUS / target, ignore_errors=True)
         (CORPUS / target).mkdir(parents=True)
     FILES.mkdir(exist_ok=True)
@@ -234,6 +290,7 @@ def main():
     json_seeds()
     range_seeds()
     config_seeds()
+    bundle_seeds()
 
 
 if __name__ == "__main__":

@@ -25,6 +25,9 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addCalibrateCommand(app, io, exitCode);
   addCaptureCommand(app, io, exitCode);
   addConfigCommand(app, io, exitCode);
+  addKeygenCommand(app, io, exitCode);
+  addBundleCommand(app, io, exitCode);
+  addVerifyBundleCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -18,5 +18,8 @@ void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addConfigCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addKeygenCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host
