@@ -13,8 +13,15 @@ A unit's inputs are hashed into its cache key:
 Only clean results are stored: a unit with a finding is analysed again on every run and fails
 every run until the finding is fixed.
 
+A list of keys known clean (--known-clean, tests/static/tidy-clean.txt in the repository) is a
+second, read-only cache that travels with the sources: CI on a fresh machine analyses only the
+units whose inputs differ from those of a clean analysis recorded in the list. The list is
+written by --record-known-clean after a run without findings (cmake --build --preset host
+--target record_tidy_clean); a stale entry only costs an analysis, never hides a finding.
+
 Usage: clang_tidy_cached.py --clang-tidy BIN --clang BIN --build DIR --source-root DIR
-                            [--cache DIR] [--jobs N] [--extra-arg ARG ...] FILE...
+                            [--cache DIR] [--jobs N] [--extra-arg ARG ...]
+                            [--known-clean LIST] [--record-known-clean LIST] FILE...
 The cache defaults to $SMX_TIDY_CACHE, else $XDG_CACHE_HOME/stripemux/clang-tidy, else
 ~/.cache/stripemux/clang-tidy. Exit status: 0 when no unit has a finding, 1 otherwise, 2 on a
 usage error (an unknown file, a missing tool).
@@ -105,14 +112,24 @@ class Unit:
         return digest.hexdigest()
 
 
+def read_known_clean(path):
+    """The keys of a known-clean list ("KEY PATH" per line); none for a missing list."""
+    if path is None or not path.exists():
+        return set()
+    return {line.split(" ", 1)[0] for line in path.read_text().splitlines() if line.strip()}
+
+
 def analyse(unit, options, common):
-    """Returns (unit, status, output, seconds); status is 'cached', 'clean' or 'finding'."""
+    """Returns (unit, key, status, output, seconds); status is 'cached', 'known clean', 'clean'
+    or 'finding'."""
     start = time.monotonic()
     key = unit.key(common, options.clang, options.extra_arg)
     stored = options.cache / key[:2] / key[2:] if key else None
     if stored is not None and stored.exists():
         os.utime(stored)  # recently used: kept by any pruning by age
-        return unit, "cached", "", time.monotonic() - start
+        return unit, key, "cached", "", time.monotonic() - start
+    if key is not None and key in options.known:
+        return unit, key, "known clean", "", time.monotonic() - start
     command = [options.clang_tidy, "-p", str(options.build), "--quiet"]
     command += ["--extra-arg=" + arg for arg in options.extra_arg] + [str(unit.path)]
     result = subprocess.run(command, cwd=options.source_root, capture_output=True, text=True)
@@ -123,7 +140,7 @@ def analyse(unit, options, common):
         with tempfile.NamedTemporaryFile("w", dir=stored.parent, delete=False) as tmp:
             tmp.write(unit.relative + "\n")
         os.replace(tmp.name, stored)
-    return unit, "finding" if found else "clean", output, time.monotonic() - start
+    return unit, key, "finding" if found else "clean", output, time.monotonic() - start
 
 
 def parse_args(argv):
@@ -136,10 +153,15 @@ def parse_args(argv):
     parser.add_argument("--cache", type=pathlib.Path, default=default_cache())
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--extra-arg", action="append", default=[])
+    parser.add_argument("--known-clean", type=pathlib.Path,
+                        help="list of keys analysed clean elsewhere (read only)")
+    parser.add_argument("--record-known-clean", type=pathlib.Path,
+                        help="after a run without findings, write the units' keys here")
     parser.add_argument("files", nargs="+", type=pathlib.Path)
     options = parser.parse_args(argv)
     options.build = options.build.resolve()
     options.source_root = options.source_root.resolve()
+    options.known = read_known_clean(options.known_clean)
     return options
 
 
@@ -166,19 +188,30 @@ def main(argv):
         print(f"clang-tidy: {error}", file=sys.stderr)
         return 2
 
-    counts = {"cached": 0, "clean": 0, "finding": 0}
+    counts = {"cached": 0, "known clean": 0, "clean": 0, "finding": 0}
+    keys = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, options.jobs)) as pool:
         jobs = [pool.submit(analyse, unit, options, common) for unit in units]
         for job in concurrent.futures.as_completed(jobs):
-            unit, status, output, seconds = job.result()
+            unit, key, status, output, seconds = job.result()
             counts[status] += 1
+            if key is not None:
+                keys.append(f"{key} {unit.relative}")
             print(f"{unit.relative}: {status} ({seconds:.1f} s)")
             if status == "finding":
                 print(output, end="" if output.endswith("\n") else "\n")
     print(f"clang-tidy: {len(units)} units, {counts['cached']} unchanged since a clean analysis, "
-          f"{counts['clean']} analysed clean, {counts['finding']} with findings "
-          f"(cache {options.cache})")
-    return 1 if counts["finding"] else 0
+          f"{counts['known clean']} in the known-clean list, {counts['clean']} analysed clean, "
+          f"{counts['finding']} with findings (cache {options.cache})")
+    if counts["finding"]:
+        return 1
+    if options.record_known_clean is not None:
+        target = options.record_known_clean
+        with tempfile.NamedTemporaryFile("w", dir=target.parent, delete=False) as tmp:
+            tmp.write("".join(line + "\n" for line in sorted(keys, key=lambda k: k.split(" ")[1])))
+        os.replace(tmp.name, target)
+        print(f"clang-tidy: {len(keys)} clean units recorded in {target}")
+    return 0
 
 
 if __name__ == "__main__":

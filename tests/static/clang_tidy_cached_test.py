@@ -63,20 +63,20 @@ class ClangTidyCacheTest(unittest.TestCase):
         }]
         (root / "build" / "compile_commands.json").write_text(json.dumps(database))
 
-    def run_cached(self, tree=None):
+    def run_cached(self, tree=None, options=()):
         tree = tree or self.tree
         result = subprocess.run(
             [sys.executable, str(SCRIPT), "--clang-tidy", CLANG_TIDY, "--clang", CLANG,
              "--build", str(tree / "build"), "--source-root", str(tree),
-             "--cache", str(self.cache), "--extra-arg=-std=c++2b", "algo/unit.cpp"],
+             "--cache", str(self.cache), "--extra-arg=-std=c++2b", *options, "algo/unit.cpp"],
             capture_output=True, text=True)
         return result.returncode, result.stdout + result.stderr
 
     def set_helper(self, text):
         (self.tree / "algo" / "helper.hpp").write_text(text)
 
-    def assert_status(self, status, tree=None):
-        code, output = self.run_cached(tree)
+    def assert_status(self, status, tree=None, options=()):
+        code, output = self.run_cached(tree, options)
         self.assertIn(f"algo/unit.cpp: {status} (", output)
         self.assertEqual(code, 1 if status == "finding" else 0, output)
         return output
@@ -114,6 +114,21 @@ class ClangTidyCacheTest(unittest.TestCase):
         self.assert_status("clean")
         other = self.make_tree(self.tmp / "clone-b")
         self.assert_status("cached", other)
+
+    # A list recorded on one machine lets a fresh machine (an empty cache) skip the unit, until
+    # anything it reads changes; a run with a finding records nothing.
+    def test_a_known_clean_list_travels_with_the_sources(self):
+        listed = self.tmp / "tidy-clean.txt"
+        self.assert_status("clean", options=("--record-known-clean", str(listed)))
+        self.assertRegex(listed.read_text(), r"^[0-9a-f]{64} algo/unit.cpp\n$")
+        shutil.rmtree(self.cache)
+        other = self.make_tree(self.tmp / "clone-b")
+        self.assert_status("known clean", other, ("--known-clean", str(listed)))
+        (other / "algo" / "helper.hpp").write_text(CAST_HELPER)
+        self.assert_status("finding", other, ("--known-clean", str(listed),
+                                               "--record-known-clean", str(listed)))
+        self.assertRegex(listed.read_text(), r"^[0-9a-f]{64} algo/unit.cpp\n$")
+        self.assert_status("finding", other, ("--known-clean", str(listed)))
 
 
 if __name__ == "__main__":

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -53,10 +55,10 @@ Eigen::Vector3d centreOf(const algo::DeviceModel& d) {
   return {c[0], c[1], c[2]};
 }
 
-void setPose(algo::DeviceModel& d, const Eigen::Matrix3d& R, const Eigen::Vector3d& centre) {
-  const Eigen::Vector3d t = -R * centre;
+void setPose(algo::DeviceModel& d, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& centre) {
+  const Eigen::Vector3d t = -rotation * centre;
   for (int i = 0; i < 9; ++i) {
-    d.R[static_cast<std::size_t>(i)] = R(i / 3, i % 3);
+    d.R[static_cast<std::size_t>(i)] = rotation(i / 3, i % 3);
   }
   d.t = {t[0], t[1], t[2]};
 }
@@ -84,11 +86,11 @@ void perturb(algo::DeviceModel& d, Rng& rng, bool move, double k1Range) {
 }
 
 double axesDeg(const algo::DeviceModel& a, const algo::DeviceModel& b) {
-  const Mat3 Ra = rotationOf(a);
-  const Mat3 Rb = rotationOf(b);
+  const Mat3 ra = rotationOf(a);
+  const Mat3 rb = rotationOf(b);
   double worst = 0;
   for (int i = 0; i < 3; ++i) {
-    const double c = std::clamp(Ra.row(i).dot(Rb.row(i)), -1.0, 1.0);
+    const double c = std::clamp(ra.row(i).dot(rb.row(i)), -1.0, 1.0);
     worst = std::max(worst, std::acos(c) * 180 / std::numbers::pi);
   }
   return worst;
@@ -144,69 +146,89 @@ algo::Rig drawRealRig(const algo::Rig& nominal, std::uint64_t seed) {
   return real;
 }
 
+namespace {
+
+// The stripe coordinate the projector throws on a world point, if it lies inside its image.
+std::optional<double> stripeAt(const algo::Projector& proj, const lens::Point3& world) {
+  const auto q = lens::project(proj, world);
+  if (!q || q->x < 0 || q->y < 0 || q->x > proj.width - 1 || q->y > proj.height - 1) {
+    return std::nullopt;
+  }
+  return algo::stripeCoordinate(proj.pattern, proj.width, proj.height, q->x, q->y);
+}
+
+// The root of f in [lo, hi] by bisection, when f is defined at both ends and changes sign there.
+// Small on purpose: clang-tidy's optional-access analysis grows steeply with a function's loops.
+std::optional<double> bisect(const std::function<std::optional<double>(double)>& f, double lo,
+                             double hi) {
+  const std::optional<double> atLo = f(lo);
+  const std::optional<double> atHi = f(hi);
+  if (!atLo || !atHi || (*atLo > 0) == (*atHi > 0)) {
+    return std::nullopt;
+  }
+  const bool positiveAtLo = *atLo > 0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = (lo + hi) / 2;
+    const std::optional<double> atMid = f(mid);
+    if (!atMid) {
+      break;
+    }
+    if ((*atMid > 0) == positiveAtLo) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  return (lo + hi) / 2;
+}
+
+// The depth the calibrated camera and projector give the camera pixel that sees depth z through
+// the real ones, if the projector lights it in both.
+std::optional<double> calibratedDepth(const algo::Camera& realCamera,
+                                      const algo::Projector& realProjector,
+                                      const algo::Camera& calCamera,
+                                      const algo::Projector& calProjector, lens::Point2 pixel,
+                                      double z) {
+  const auto local = lens::devicePoint(realCamera, pixel, z);
+  if (!local) {
+    return std::nullopt;
+  }
+  const auto s = stripeAt(realProjector, lens::toWorld(realCamera, *local));
+  if (!s) {
+    return std::nullopt;
+  }
+  // Where along the calibrated camera's ray for the pixel the stripe coordinate is s.
+  const double stripe = *s;
+  return bisect(
+      [&](double zc) -> std::optional<double> {
+        const auto l = lens::devicePoint(calCamera, pixel, zc);
+        const auto sc = l ? stripeAt(calProjector, lens::toWorld(calCamera, *l)) : std::nullopt;
+        return sc ? std::optional<double>(*sc - stripe) : std::nullopt;
+      },
+      z * 0.8, z * 1.2);
+}
+
+}  // namespace
+
 void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std::size_t p,
                         DeviceError& error) {
-  const algo::Camera& rc = real.cameras[0];
-  const algo::Camera& cc = calibrated.cameras[0];
-  const algo::Projector& rp = real.projectors[p];
-  const algo::Projector& cp = calibrated.projectors[p];
-  const auto stripeAt = [](const algo::Projector& proj,
-                           const lens::Point3& world) -> std::optional<double> {
-    const auto q = lens::project(proj, world);
-    if (!q || q->x < 0 || q->y < 0 || q->x > proj.width - 1 || q->y > proj.height - 1) {
-      return std::nullopt;
-    }
-    return algo::stripeCoordinate(proj.pattern, proj.width, proj.height, q->x, q->y);
-  };
+  const algo::Camera& camera = real.cameras[0];
   double sum = 0;
   double worst = 0;
   int n = 0;
   constexpr int kStepPx = 16;
-  for (int y = kStepPx / 2; y < rc.height; y += kStepPx) {
-    for (int x = kStepPx / 2; x < rc.width; x += kStepPx) {
+  for (int y = kStepPx / 2; y < camera.height; y += kStepPx) {
+    for (int x = kStepPx / 2; x < camera.width; x += kStepPx) {
       for (const double z : {0.6, 0.8, 1.0, 1.2}) {
-        const lens::Point2 pixel{static_cast<double>(x), static_cast<double>(y)};
-        const auto local = lens::devicePoint(rc, pixel, z);
-        if (!local) {
-          continue;
+        const auto zc = calibratedDepth(camera, real.projectors[p], calibrated.cameras[0],
+                                        calibrated.projectors[p],
+                                        {static_cast<double>(x), static_cast<double>(y)}, z);
+        if (zc) {
+          const double e = (*zc - z) * 1000;
+          sum += e * e;
+          worst = std::max(worst, std::abs(e));
+          ++n;
         }
-        const auto s = stripeAt(rp, lens::toWorld(rc, *local));
-        if (!s) {
-          continue;
-        }
-        // The calibrated rig: where along its ray for the pixel the stripe coordinate is s.
-        const auto f = [&](double zc) -> std::optional<double> {
-          const auto l = lens::devicePoint(cc, pixel, zc);
-          if (!l) {
-            return std::nullopt;
-          }
-          const auto sc = stripeAt(cp, lens::toWorld(cc, *l));
-          return sc ? std::optional<double>(*sc - *s) : std::nullopt;
-        };
-        double lo = z * 0.8;
-        double hi = z * 1.2;
-        auto flo = f(lo);
-        auto fhi = f(hi);
-        if (!flo || !fhi || (*flo > 0) == (*fhi > 0)) {
-          continue;
-        }
-        for (int i = 0; i < 60; ++i) {
-          const double mid = (lo + hi) / 2;
-          const auto fm = f(mid);
-          if (!fm) {
-            break;
-          }
-          if ((*fm > 0) == (*flo > 0)) {
-            lo = mid;
-            flo = fm;
-          } else {
-            hi = mid;
-          }
-        }
-        const double e = ((lo + hi) / 2 - z) * 1000;
-        sum += e * e;
-        worst = std::max(worst, std::abs(e));
-        ++n;
       }
     }
   }
@@ -215,7 +237,8 @@ void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std:
 }
 
 std::vector<CalibrationCase> runCalibrationEval(const CalibrationEvalOptions& options) {
-  std::vector<std::string> scenes = options.scenes.empty() ? sim::namedScenes() : options.scenes;
+  const std::vector<std::string> scenes =
+      options.scenes.empty() ? sim::namedScenes() : options.scenes;
   std::vector<CalibrationCase> cases;
   for (std::size_t r = 0; r < options.rigs.size(); ++r) {
     for (const int poses : options.poseCounts) {
