@@ -95,14 +95,14 @@ TEST(HealthDrift, MovesAndTurnsTheProjectorAboutItsCentre) {
   const algo::Projector& p = rig.projectors[1];
   const algo::lens::Point3 before = algo::lens::centre(p);
   const Drift shift{{0.001, 0, 0}, {}};
-  const algo::Projector& moved = withDrift(rig, 1, shift).projectors[1];
+  const algo::Projector moved = withDrift(rig, 1, shift).projectors[1];
   const algo::lens::Point3 after = algo::lens::centre(moved);
   // The projector's x axis in the world is the first row of R (world → device).
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_NEAR(after[i] - before[i], 0.001 * p.R[i], 1e-12);
   }
   const double angle = 0.2 * std::numbers::pi / 180.0;
-  const algo::Projector& turned = withDrift(rig, 1, {{}, {0, angle, 0}}).projectors[1];
+  const algo::Projector turned = withDrift(rig, 1, {{}, {0, angle, 0}}).projectors[1];
   const algo::lens::Point3 centre = algo::lens::centre(turned);
   double axisDot = 0;
   for (std::size_t i = 0; i < 3; ++i) {

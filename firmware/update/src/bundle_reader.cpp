@@ -17,7 +17,10 @@ std::unexpected<UpdateError> fail(UpdateReason reason, const std::string& what) 
 }
 
 bool matches(std::span<const std::byte> bytes, std::size_t at, std::span<const char> magic) {
-  return std::memcmp(bytes.data() + at, magic.data(), magic.size()) == 0;
+  // The first bytes of a cut file are compared with as much of the magic as there is, which may
+  // be none: an empty span may have no data pointer, which memcmp must never see.
+  return bytes.size() >= at + magic.size() &&
+         (magic.empty() || std::memcmp(bytes.data() + at, magic.data(), magic.size()) == 0);
 }
 
 struct Sections {
