@@ -136,17 +136,9 @@ std::expected<void, std::string> Settings::store(const config::DeviceConfig& nex
 
 std::string Settings::describe() const {
   std::string keys;
-  const auto add = [&](bool set, const char* key) {
-    if (set) {
-      keys += (keys.empty() ? "" : ", ") + std::string(key);
-    }
-  };
-  add(stored_.fps.has_value(), "fps");
-  add(stored_.compression.has_value(), "compression");
-  add(stored_.depthMinM.has_value(), "depth_min_m");
-  add(stored_.depthMaxM.has_value(), "depth_max_m");
-  add(stored_.confidenceMin.has_value(), "confidence_min");
-  add(stored_.rig.has_value(), "rig");
+  for (const std::string_view key : config::setKeys(stored_)) {
+    keys += (keys.empty() ? "" : ", ") + std::string(key);
+  }
   if (keys.empty()) {
     return stateDir_.empty() ? "the board's (no state directory)" : "the board's";
   }

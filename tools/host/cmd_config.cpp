@@ -2,11 +2,9 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,6 +13,8 @@
 #include "device_client.hpp"
 #include "device_option.hpp"
 #include "smx/config/device_config.hpp"
+#include "smx/config/json_errors.hpp"
+#include "smx/config/rig_json.hpp"
 #include "terminal_text.hpp"
 
 namespace smx::host {
@@ -52,28 +52,6 @@ std::string settingKeysList() {
   return list;
 }
 
-// A file the host reads for the device: its size is checked before it is read.
-std::expected<std::string, std::string> readSmallFile(const fs::path& path) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  if (ec || !fs::is_regular_file(path, ec)) {
-    return std::unexpected(path.string() + ": cannot read the file" +
-                           (ec ? ": " + ec.message() : std::string(": not a regular file")));
-  }
-  if (size > config::kDeviceConfigMaxBytes) {
-    return std::unexpected(path.string() + ": " + std::to_string(size) +
-                           " bytes; settings are at most " +
-                           std::to_string(config::kDeviceConfigMaxBytes) + " bytes");
-  }
-  const std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) {
-    return std::unexpected(path.string() + ": cannot read the file");
-  }
-  return text.str();
-}
-
 // KEY=VALUE… as a stripemux-config/1 change. A value is JSON when it reads as JSON (numbers),
 // else a word (compression=rvl); rig=FILE embeds that rig.json. The device checks the values.
 std::expected<std::string, Failure> changeFromAssignments(const std::vector<std::string>& assign) {
@@ -92,15 +70,12 @@ std::expected<std::string, Failure> changeFromAssignments(const std::vector<std:
     }
     const std::string value = item.substr(eq + 1);
     if (key == "rig") {
-      auto text = readSmallFile(value);
-      if (!text) {
-        return std::unexpected(Failure{kExitBadInput, "set rig: " + text.error()});
+      // Read and checked here, so that a broken file is named; the device checks it fits.
+      const auto rig = config::loadRig(value);
+      if (!rig) {
+        return std::unexpected(Failure{kExitBadInput, "set rig: " + rig.error().message()});
       }
-      const Json rig = Json::parse(*text, nullptr, false);
-      if (rig.is_discarded()) {
-        return std::unexpected(Failure{kExitBadInput, "set rig: " + value + ": not valid JSON"});
-      }
-      doc[key] = rig;
+      doc[key] = Json::parse(config::toJson(*rig));
       continue;
     }
     const Json parsed = Json::parse(value, nullptr, false);
@@ -127,9 +102,11 @@ std::expected<std::string, Failure> changeFromSource(const std::string& source) 
                                                    "\" (presets: " + names +
                                                    "; a file needs a .json name or a path)"});
   }
-  auto text = readSmallFile(source);
+  auto text = config::readDeviceConfigText(source);
   if (!text) {
-    return std::unexpected(Failure{kExitBadInput, "apply: " + text.error()});
+    return std::unexpected(Failure{
+        kExitBadInput,
+        "apply: " + config::errorMessage(source, text.error().field, text.error().problem)});
   }
   return std::move(*text);
 }

@@ -185,10 +185,25 @@ std::expected<DeviceConfig, FieldError> parseDeviceConfig(std::string_view text,
   }
 }
 
+std::expected<std::string, FieldError> readDeviceConfigText(const std::filesystem::path& file) {
+  return readDocumentFile(file, kConfigDocument);
+}
+
+std::vector<std::string_view> setKeys(const DeviceConfig& config) {
+  const Json doc = settingsJson(config);
+  std::vector<std::string_view> keys;
+  for (const std::string_view key : kSettingKeys) {
+    if (doc.contains(key)) {
+      keys.push_back(key);
+    }
+  }
+  return keys;
+}
+
 std::expected<DeviceConfig, FieldError> loadDeviceConfig(const std::filesystem::path& file,
                                                          const Board& board) {
   try {
-    auto text = readDocumentFile(file, kConfigDocument);
+    auto text = readDeviceConfigText(file);
     if (!text) {
       return std::unexpected(text.error());
     }

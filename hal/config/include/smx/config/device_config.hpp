@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "smx/algo/rig.hpp"
 #include "smx/config/board_json.hpp"
@@ -44,6 +45,13 @@ struct DeviceConfig {
 // Reads `file` and parses it against `board`; an unreadable file is an error with no field.
 [[nodiscard]] std::expected<DeviceConfig, FieldError> loadDeviceConfig(
     const std::filesystem::path& file, const Board& board);
+
+// The text of a config.json file, its size checked before it is read (no field in the error).
+[[nodiscard]] std::expected<std::string, FieldError> readDeviceConfigText(
+    const std::filesystem::path& file);
+
+// The keys `config` sets, in deviceConfigKeys() order.
+[[nodiscard]] std::vector<std::string_view> setKeys(const DeviceConfig& config);
 
 // `stored` with every setting `change` has replaced.
 [[nodiscard]] DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change);
