@@ -102,19 +102,20 @@ int run(const Options& opts) {
   for (auto& camera : config.cameras) {
     camera.format.fps = opts.fps > 0 ? opts.fps : camera.format.fps;
   }
-  std::string report;
-  auto settings = smx::firmware::Settings::load(opts.state, *board, report);
-  std::fputs(report.c_str(), stdout);
-  if (!settings) {
-    std::fprintf(stderr, "stripemuxd: %s\n", settings.error().c_str());
-    return 1;
-  }
   // The HAL is the hardware: it stays while the settings change (the simulated world keeps the
   // board's rig, whatever rig the owner installs).
   auto hal = smx::hal::createBoardHal(config, board->rig);
   if (!hal) {
     std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(), hal.error().c_str());
     return 3;
+  }
+  std::string report;
+  auto settings = smx::firmware::Settings::load(opts.state, *board,
+                                                smx::firmware::hardwareOf((*hal)->hal()), report);
+  std::fputs(report.c_str(), stdout);
+  if (!settings) {
+    std::fprintf(stderr, "stripemuxd: %s\n", settings.error().c_str());
+    return 1;
   }
   smx::device::DeviceOptions base;
   base.firmwareVersion = SMX_VERSION;

@@ -22,14 +22,33 @@ algo::PipelineOptions pipelineOptions(const config::DeviceConfig& c, const confi
   return base;
 }
 
-// What Device::create() would refuse about the settings' rig and window, before they are stored.
-std::expected<void, std::string> checkPipelines(const config::DeviceConfig& c,
-                                                const config::Board& physical) {
+std::expected<void, std::string> checkHardware(const config::DeviceConfig& c,
+                                               const Hardware& hardware) {
+  if (c.exposureUs.value_or(0) != 0 && !hardware.cameras.exposure) {
+    return std::unexpected("exposure_us: the board's cameras have no exposure control");
+  }
+  if (c.gain.value_or(0.0) != 0.0 && !hardware.cameras.gain) {
+    return std::unexpected("gain: the board's cameras have no gain control");
+  }
+  if (c.projectorPower.value_or(100) != 100 && !hardware.dimmable) {
+    return std::unexpected(
+        "projector_power: the board's trigger lines only switch its projectors on and off");
+  }
+  return {};
+}
+
+// What Device::create() would refuse about the settings, before they are stored.
+std::expected<void, std::string> checkSettings(const config::DeviceConfig& c,
+                                               const config::Board& physical,
+                                               const Hardware& hardware) {
+  if (auto fits = checkHardware(c, hardware); !fits) {
+    return fits;
+  }
   const config::Board board = config::appliedTo(c, physical);
   const auto options = pipelineOptions(c, board, {});
-  for (std::size_t i = 0; i < board.rig.cameras.size(); ++i) {
-    if (const auto setup = algo::prepareCameraPipeline(board.rig, static_cast<int>(i), options);
-        !setup) {
+  const algo::Rig rig = config::rangeRig(board);
+  for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
+    if (const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(i), options); !setup) {
       return std::unexpected("the device cannot decode camera " + board.rig.cameras[i].id +
                              " with these settings: " + setup.error());
     }
@@ -43,9 +62,20 @@ std::string fieldMessage(const config::FieldError& e) {
 
 }  // namespace
 
+Hardware hardwareOf(const hal::Hal& hal) {
+  Hardware hardware{.cameras = {.exposure = true, .gain = true},
+                    .dimmable = hal.trigger.dimmable()};
+  for (const hal::Camera* camera : hal.cameras) {
+    const hal::CameraControlSupport support = camera->controlSupport();
+    hardware.cameras.exposure = hardware.cameras.exposure && support.exposure;
+    hardware.cameras.gain = hardware.cameras.gain && support.gain;
+  }
+  return hardware;
+}
+
 std::expected<Settings, std::string> Settings::load(const fs::path& stateDir, config::Board board,
-                                                    std::string& report) {
-  Settings settings(stateDir, std::move(board));
+                                                    Hardware hardware, std::string& report) {
+  Settings settings(stateDir, std::move(board), hardware);
   if (stateDir.empty()) {
     return settings;
   }
@@ -64,7 +94,8 @@ std::expected<Settings, std::string> Settings::load(const fs::path& stateDir, co
   // board.json, a hand edit): the device still starts, with the board's settings.
   auto stored = config::loadDeviceConfig(file, settings.board_);
   std::expected<void, std::string> fits =
-      stored ? checkPipelines(*stored, settings.board_) : std::expected<void, std::string>{};
+      stored ? checkSettings(*stored, settings.board_, settings.hardware_)
+             : std::expected<void, std::string>{};
   if (!stored || !fits) {
     const fs::path rejected = stateDir / "config.json.rejected";
     fs::rename(file, rejected, ec);
@@ -111,7 +142,7 @@ std::expected<std::string, std::string> Settings::change(const protocol::SetConf
     change = std::move(*parsed);
   }
   const config::DeviceConfig next = config::merged(base, change);
-  if (auto fits = checkPipelines(next, board_); !fits) {
+  if (auto fits = checkSettings(next, board_, hardware_); !fits) {
     return std::unexpected(fits.error());
   }
   if (auto stored = store(next); !stored) {

@@ -50,7 +50,9 @@ void renderFrame(benchmark::State& state, const std::string& rigName,
   std::vector<float> depth(n);
   smx::sim::GroundTruthViews truth;
   truth.depth = *smx::algo::ImageView<float>::packed(depth, cam.width, cam.height);
-  smx::sim::FrameRequest request{0, 0, std::vector<bool>(setup.rig.projectors.size(), true), 1};
+  smx::sim::FrameRequest request;
+  request.lit.assign(setup.rig.projectors.size(), true);
+  request.seed = 1;
   for (auto _ : state) {
     auto r = setup.renderer->render(request, image, state.range(1) != 0 ? &truth : nullptr);
     benchmark::DoNotOptimize(r);

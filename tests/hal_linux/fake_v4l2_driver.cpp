@@ -141,6 +141,27 @@ int FakeV4l2Driver::ioctl(int fd, unsigned long request, void* arg) {
       }
       streaming_ = true;
       return 0;
+    case VIDIOC_QUERYCTRL: {
+      auto& query = *static_cast<v4l2_queryctrl*>(arg);
+      const auto it = controls.find(query.id);
+      if (it == controls.end()) {
+        return -EINVAL;
+      }
+      query = it->second;
+      return 0;
+    }
+    case VIDIOC_S_CTRL: {
+      const auto& control = *static_cast<v4l2_control*>(arg);
+      const auto it = controls.find(control.id);
+      if (it == controls.end()) {
+        return -EINVAL;
+      }
+      if (control.value < it->second.minimum || control.value > it->second.maximum) {
+        return -ERANGE;
+      }
+      controlValues[control.id] = control.value;
+      return 0;
+    }
     case VIDIOC_STREAMOFF:
       // The kernel hands every buffer back to user space, queued or done.
       streaming_ = false;

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <span>
 #include <utility>
 #include <vector>
@@ -34,6 +35,9 @@ class FakeV4l2Driver final : public lnx::V4l2Io {
   int sParmResult = 0;                                    // e.g. -ENOTTY: no frame-rate control
   std::uint32_t maxBuffers = 32;
   int pollEintrOnce = 0;  // the next poll returns -EINTR this many times
+  // Controls the device has (id → range and default), and the values S_CTRL set.
+  std::map<std::uint32_t, v4l2_queryctrl> controls;
+  std::map<std::uint32_t, std::int32_t> controlValues;
 
   // The device node: present or unplugged.
   void unplug() { present_ = false; }

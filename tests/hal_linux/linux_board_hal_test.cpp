@@ -20,7 +20,8 @@ struct Fixture {
       board.cameras.push_back(CameraConfig{.id = id,
                                            .device = "/dev/smx-no-such-video",
                                            .format = {640, 480, PixelFormat::kYuyv, 30},
-                                           .buffers = 4});
+                                           .buffers = 4,
+                                           .controls = {}});
     }
     board.trigger.lines = {{.role = "proj0", .chip = "gpiochip0", .offset = 1},
                            {.role = "proj1", .chip = "gpiochip0", .offset = 2}};

@@ -544,6 +544,66 @@ TEST_F(V4l2CameraTest, ConfigureWhileAnotherUserHoldsTheBuffersIsBusy) {
   EXPECT_TRUE(second->configure(CameraFormat{6, 3, PixelFormat::kRgb24, 30}));
 }
 
+v4l2_queryctrl control(std::uint32_t id, std::int32_t minimum, std::int32_t maximum,
+                       std::int32_t defaultValue) {
+  v4l2_queryctrl query{};
+  query.id = id;
+  query.minimum = minimum;
+  query.maximum = maximum;
+  query.default_value = defaultValue;
+  query.step = 1;
+  return query;
+}
+
+// A UVC-like camera: auto exposure (menu, default aperture priority), exposure in 100 µs units,
+// gain whose default (32) is unity.
+TEST_F(V4l2CameraTest, ExposureAndGainAreSetInTheDriversUnitsAndRestoredOnReopen) {
+  driver_.controls[V4L2_CID_EXPOSURE_AUTO] =
+      control(V4L2_CID_EXPOSURE_AUTO, 0, 3, V4L2_EXPOSURE_APERTURE_PRIORITY);
+  driver_.controls[V4L2_CID_EXPOSURE_ABSOLUTE] = control(V4L2_CID_EXPOSURE_ABSOLUTE, 3, 2047, 156);
+  driver_.controls[V4L2_CID_GAIN] = control(V4L2_CID_GAIN, 0, 255, 32);
+  auto camera = streaming(PixelFormat::kRgb24);
+  EXPECT_TRUE(camera->controlSupport().exposure);
+  EXPECT_TRUE(camera->controlSupport().gain);
+
+  ASSERT_TRUE(camera->setControls({.exposureUs = 20'000, .gain = 2.5}));
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_EXPOSURE_AUTO], V4L2_EXPOSURE_MANUAL);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_EXPOSURE_ABSOLUTE], 200);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_GAIN], 80);
+
+  // Beyond the control's range: refused, and what was set stays.
+  const auto tooLong = camera->setControls({.exposureUs = 300'000, .gain = std::nullopt});
+  ASSERT_FALSE(tooLong);
+  EXPECT_EQ(tooLong.error().code, HalErrc::kInvalidArgument);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_GAIN], 80);
+
+  // A replugged device starts with its defaults: reopen() sets the controls again.
+  driver_.unplug();
+  (void)camera->acquire(kTimeoutNs);
+  driver_.plug();
+  driver_.controlValues.clear();
+  ASSERT_TRUE(camera->reopen());
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_EXPOSURE_ABSOLUTE], 200);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_GAIN], 80);
+
+  // Nothing set: the driver's defaults, automatic exposure again.
+  ASSERT_TRUE(camera->setControls({}));
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_EXPOSURE_AUTO], V4L2_EXPOSURE_APERTURE_PRIORITY);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_EXPOSURE_ABSOLUTE], 156);
+  EXPECT_EQ(driver_.controlValues[V4L2_CID_GAIN], 32);
+}
+
+TEST_F(V4l2CameraTest, ACameraWithoutControlsRefusesExposureAndGain) {
+  auto camera = streaming(PixelFormat::kRgb24);
+  EXPECT_FALSE(camera->controlSupport().exposure);
+  EXPECT_FALSE(camera->controlSupport().gain);
+  const auto refused = camera->setControls({.exposureUs = 5000, .gain = std::nullopt});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, HalErrc::kNotSupported);
+  EXPECT_TRUE(camera->setControls({}));
+  EXPECT_TRUE(driver_.controlValues.empty());
+}
+
 TEST_F(V4l2CameraTest, SteadyStateAcquireAndReleaseNeverAllocate) {
   for (const PixelFormat format : {PixelFormat::kRgb24, PixelFormat::kBgr24, PixelFormat::kYuyv}) {
     auto camera = streaming(format);

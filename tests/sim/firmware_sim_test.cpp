@@ -382,6 +382,39 @@ TEST_F(FirmwareSim, TriggerLinesAreActiveDuringEveryExposure) {
   EXPECT_EQ(running.control().lastExposureMask(1), 0b11U);
 }
 
+// The owner's projector subset (docs/config.md): range captures light only those lines, and a
+// replaying board, whose images cannot change, refuses dimming and exposure.
+TEST_F(FirmwareSim, RangeCapturesLightOnlyTheChosenProjectors) {
+  config::Board board = simBoard(2);
+  board.config.trigger.rangeMask = 0b10U;
+  auto made = hal::createBoardHal(board.config, board.rig);
+  ASSERT_TRUE(made.has_value()) << made.error();
+  auto device = device::Device::create(board, (*made)->hal(), {});
+  ASSERT_TRUE(device.has_value()) << device.error();
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE((*device)->captureOnce().has_value());
+  }
+  const auto edges = sim::simBoardControl(**made)->triggerEdges();
+  ASSERT_EQ(edges.size(), 4U);
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    EXPECT_EQ(edges[i].activeMask, i % 2 == 0 ? 0b10U : 0U) << "edge " << i;
+  }
+  device->reset();
+
+  board.config.trigger.powerPercent = 50;
+  auto dimmed = device::Device::create(board, (*made)->hal(), {});
+  ASSERT_FALSE(dimmed.has_value());
+  EXPECT_NE(dimmed.error().find("projector_power"), std::string::npos) << dimmed.error();
+  board.config.trigger.powerPercent = 100;
+  for (smx::hal::Camera* camera : (*made)->hal().cameras) {
+    (void)camera->stop();
+  }
+  board.config.cameras[0].controls.exposureUs = 5000;
+  auto exposed = device::Device::create(board, (*made)->hal(), {});
+  ASSERT_FALSE(exposed.has_value());
+  EXPECT_NE(exposed.error().find("exposure"), std::string::npos) << exposed.error();
+}
+
 TEST_F(FirmwareSim, CameraFaultsAreCountedAndCaptureRecovers) {
   RunningDevice running(1);
   running.control().injectTimeouts(0, 2);

@@ -85,10 +85,14 @@ cp "$state/config.json" "$work/before.json"
 set +e
 "$tool" config --device "$device" set fps=500 >/dev/null 2>"$work/err"; code=$?
 "$tool" config --device "$device" set exposure=3 >/dev/null 2>"$work/err2"; code2=$?
+"$tool" config --device "$device" set exposure_us=5000 >/dev/null 2>"$work/err3"; code3=$?
 set -e
 [ "$code" -eq 2 ] && grep -q "fps: must be an integer from 1 to 120" "$work/err" ||
   fail "fps=500: exit $code, $(cat "$work/err")"
 [ "$code2" -eq 1 ] && grep -q 'no setting "exposure"' "$work/err2" || fail "exposure: exit $code2"
+# Replayed images cannot change their exposure: the board says it has no such control.
+[ "$code3" -eq 2 ] && grep -q "exposure_us: the board's cameras have no exposure control" \
+  "$work/err3" || fail "exposure_us=5000 on a replaying board: exit $code3, $(cat "$work/err3")"
 cmp -s "$state/config.json" "$work/before.json" || fail "a refused change altered config.json"
 
 # Kept across a restart.
@@ -125,6 +129,18 @@ for step in temp-created temp-written temp-synced renamed dir-synced; do
   await_settings 2
   stop
 done
+
+# One projector of two: frames where only proj1 is lit decode once the device decodes proj1 alone.
+"$tool" sim --rig "$src/boards/sim/rig_2proj_2cam.json" --scene plane --no-truth --lit proj1 \
+  --out "$work/proj1" >/dev/null
+mv "$work/proj1/cam0.png" "$work/frames/cam0_0.png"
+mv "$work/proj1/cam1.png" "$work/frames/cam1_0.png"
+start
+"$tool" config --device "$device" set projectors=proj1 >/dev/null
+await_settings 2
+alone=$(points)
+[ "$alone" -gt 10000 ] || fail "projectors=proj1 gave $alone points of the plane lit by proj1"
+stop
 
 # reset drops every stored setting.
 start

@@ -21,7 +21,7 @@ constexpr const char* kNoDevice = "127.0.0.1:9";
 TEST(CliConfig, CommandLineMistakesAreUsageErrorsBeforeConnecting) {
   const auto unknownKey = runCli({"config", "--device", kNoDevice, "set", "exposure=3"});
   EXPECT_EQ(unknownKey.code, 1);
-  EXPECT_NE(unknownKey.err.find("no setting \"exposure\"; settings: fps, compression"),
+  EXPECT_NE(unknownKey.err.find("no setting \"exposure\"; settings: fps, exposure_us, gain"),
             std::string::npos)
       << unknownKey.err;
   const auto noValue = runCli({"config", "--device", kNoDevice, "set", "fps"});
@@ -29,10 +29,11 @@ TEST(CliConfig, CommandLineMistakesAreUsageErrorsBeforeConnecting) {
   EXPECT_NE(noValue.err.find("expected KEY=VALUE"), std::string::npos) << noValue.err;
   const auto noPreset = runCli({"config", "--device", kNoDevice, "apply", "fastest"});
   EXPECT_EQ(noPreset.code, 1);
-  EXPECT_NE(noPreset.err.find("no preset \"fastest\" (presets: fast, accurate, close-range"),
+  EXPECT_NE(noPreset.err.find(
+                "no preset \"fastest\" (presets: fast, accurate, close-range, dark-objects"),
             std::string::npos)
       << noPreset.err;
-  const auto getUnknown = runCli({"config", "--device", kNoDevice, "get", "gain"});
+  const auto getUnknown = runCli({"config", "--device", kNoDevice, "get", "brightness"});
   EXPECT_EQ(getUnknown.code, 1);
   const auto noDevice = runCli({"config", "get"});
   EXPECT_EQ(noDevice.code, 1);

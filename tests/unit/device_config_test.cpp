@@ -62,6 +62,16 @@ TEST(DeviceConfig, BadValuesAreRefusedNamingTheKey) {
       {doc(R"("depth_min_m": -1)"), "depth_min_m", "negative"},
       {doc(R"("depth_min_m": 2, "depth_max_m": 1)"), "depth_max_m", "empty"},
       {doc(R"("confidence_min": 256)"), "confidence_min", "from 1 to 255"},
+      {doc(R"("exposure_us": 0)"), "exposure_us", "from 1 to 1000000"},
+      {doc(R"("exposure_us": "auto")"), "exposure_us", "number"},
+      {doc(R"("gain": 0.5)"), "gain", "from 1 to 64"},
+      {doc(R"("gain": "camera ")"), "gain", "number"},
+      {doc(R"("projectors": [])"), "projectors", "non-empty list"},
+      {doc(R"("projectors": "proj0")"), "projectors", "non-empty list"},
+      {doc(R"("projectors": ["proj0", "proj7"])"), "projectors[1]", "not a projector of the board"},
+      {doc(R"("projectors": ["proj1", "proj1"])"), "projectors[1]", "listed twice"},
+      {doc(R"("projectors": [1])"), "projectors[0]", "not a projector"},
+      {doc(R"("projector_power": 0)"), "projector_power", "from 1 to 100"},
       {doc(R"("rig": 5)"), "rig", "object"},
       {doc(R"("rig": )" + toJson(otherIds)), "rig.cameras[0].id", "\"cam0\""},
       {doc(R"("rig": )" + toJson(otherSize)), "rig.cameras[0]", "the board's camera is"},
@@ -135,6 +145,52 @@ TEST(DeviceConfig, AppliedToTheBoardSetsFrameRateAndRig) {
   }
   EXPECT_EQ(applied.rig.projectors[0].t[0], moved.projectors[0].t[0]);
   EXPECT_EQ(applied.config.name, board.config.name);
+}
+
+TEST(DeviceConfig, CameraAndProjectorSettings) {
+  const Board board = simBoard();
+  const auto config = parseDeviceConfig(
+      doc(R"("exposure_us": 20000, "gain": 2.5, "projectors": ["proj1"], "projector_power": 40)"),
+      board);
+  ASSERT_TRUE(config.has_value()) << config.error().field << ": " << config.error().problem;
+  const Board applied = appliedTo(*config, board);
+  for (const auto& camera : applied.config.cameras) {
+    EXPECT_EQ(camera.controls.exposureUs, 20000);
+    EXPECT_EQ(camera.controls.gain, 2.5);
+  }
+  EXPECT_EQ(applied.config.trigger.powerPercent, 40);
+  // boards/sim: proj0 is line 0, proj1 line 1.
+  EXPECT_EQ(rangeProjectorsMask(applied), 0b10U);
+  const algo::Rig rig = rangeRig(applied);
+  ASSERT_EQ(rig.projectors.size(), 1U);
+  EXPECT_EQ(rig.projectors[0].id, "proj1");
+  EXPECT_EQ(rig.cameras.size(), board.rig.cameras.size());
+
+  // Listed in any order, kept in the rig's; "camera" goes back to the camera's own.
+  const auto reordered =
+      parseDeviceConfig(doc(R"("projectors": ["proj1", "proj0"], "exposure_us": "camera")"), board);
+  ASSERT_TRUE(reordered.has_value());
+  EXPECT_EQ(*reordered->projectors, (std::vector<std::string>{"proj0", "proj1"}));
+  const Board back = appliedTo(merged(*config, *reordered), board);
+  EXPECT_FALSE(back.config.cameras[0].controls.exposureUs.has_value());
+  EXPECT_EQ(back.config.cameras[0].controls.gain, 2.5);
+  EXPECT_EQ(rangeProjectorsMask(back), 0b11U);
+  const auto again = parseDeviceConfig(toJson(merged(*config, *reordered)), board);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->exposureUs, 0);
+}
+
+TEST(DeviceConfig, WithoutSettingsEveryProjectorIsLitAtFullPower) {
+  const Board board = simBoard();
+  const Board applied = appliedTo({}, board);
+  EXPECT_EQ(rangeProjectorsMask(applied), 0b11U);
+  EXPECT_EQ(applied.config.trigger.powerPercent, 100);
+  EXPECT_FALSE(applied.config.cameras[0].controls.exposureUs.has_value());
+  const auto all = parseDeviceConfig(effectiveJson({}, board), board);
+  ASSERT_TRUE(all.has_value());
+  EXPECT_EQ(*all->projectors, (std::vector<std::string>{"proj0", "proj1"}));
+  EXPECT_EQ(all->projectorPower, 100);
+  EXPECT_EQ(all->exposureUs, 0);  // "camera"
 }
 
 }  // namespace

@@ -928,6 +928,51 @@ TEST(RenderLit, ProjectorThatIsOffContributesNothing) {
   EXPECT_NE(bothOn.image, alone.image);
 }
 
+// The camera's exposure and gain and the projectors' power (the owner's settings) against the
+// same light set in the scene instead: exposure and gain scale the signal, gain the read noise
+// too, power the projectors' light alone.
+TEST(RenderControls, ExposureGainAndPowerScaleTheLightAsTheSceneWould) {
+  const algo::Rig rig = smallRig("rig_2proj_1cam.json", 4);
+  Scene scene = busyScene();
+  scene.lighting.projectorPower = 0.6;
+  scene.camera.noiseSigma = {1.0, 1.5, 2.0};
+  Scene equivalent = scene;
+  equivalent.lighting.projectorPower = 0.6 * 0.5;
+  equivalent.camera.gain = scene.camera.gain * 1.5 * 2.0;
+  equivalent.camera.noiseSigma = 2.0 * scene.camera.noiseSigma;
+  auto renderer = makeRenderer(rig, scene);
+  auto reference = makeRenderer(rig, equivalent);
+  ASSERT_NE(renderer, nullptr);
+  ASSERT_NE(reference, nullptr);
+  FrameRequest controlled = request(rig, {true, true}, 5);
+  controlled.power = {0.5, 0.5};
+  controlled.exposureScale = 1.5;
+  controlled.gain = 2.0;
+  const Frame got = renderFrame(*renderer, rig, controlled);
+  const Frame want = renderFrame(*reference, rig, request(rig, {true, true}, 5));
+  const Frame plain = renderFrame(*renderer, rig, request(rig, {true, true}, 5));
+  ASSERT_EQ(got.image.size(), want.image.size());
+  std::size_t offByOne = 0;
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < got.image.size(); ++i) {
+    const std::array<int, 3> a = {got.image[i].r, got.image[i].g, got.image[i].b};
+    const std::array<int, 3> b = {want.image[i].r, want.image[i].g, want.image[i].b};
+    for (std::size_t c = 0; c < 3; ++c) {
+      ASSERT_LE(std::abs(a[c] - b[c]), 1) << "pixel " << i;  // the products' rounding
+      offByOne += a[c] == b[c] ? 0U : 1U;
+    }
+    changed += got.image[i] == plain.image[i] ? 0U : 1U;
+  }
+  EXPECT_LT(offByOne, got.image.size() * 3 / 1000);
+  EXPECT_GT(changed, got.image.size() / 2);
+
+  // One projector dimmed to nothing is that projector off.
+  FrameRequest dimmed = request(rig, {true, true}, 5);
+  dimmed.power = {1.0, 0.0};
+  EXPECT_EQ(renderFrame(*renderer, rig, dimmed).image,
+            renderFrame(*renderer, rig, request(rig, {true, false}, 5)).image);
+}
+
 // ---- Errors ----
 
 TEST(RenderErrors, RejectsBadRequestsAndBuffers) {

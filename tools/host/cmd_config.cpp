@@ -52,8 +52,20 @@ std::string settingKeysList() {
   return list;
 }
 
+Json projectorList(const std::string& ids) {
+  Json list = Json::array();
+  std::size_t from = 0;
+  while (from <= ids.size()) {
+    const std::size_t comma = std::min(ids.find(',', from), ids.size());
+    list.push_back(ids.substr(from, comma - from));
+    from = comma + 1;
+  }
+  return list;
+}
+
 // KEY=VALUE… as a stripemux-config/1 change. A value is JSON when it reads as JSON (numbers),
-// else a word (compression=rvl); rig=FILE embeds that rig.json. The device checks the values.
+// else a word (compression=rvl); projectors=ID,ID is a list; rig=FILE embeds that rig.json. The
+// device checks the values.
 std::expected<std::string, Failure> changeFromAssignments(const std::vector<std::string>& assign) {
   Json doc = Json::object();
   doc["format"] = config::kDeviceConfigFormat;
@@ -79,6 +91,10 @@ std::expected<std::string, Failure> changeFromAssignments(const std::vector<std:
       continue;
     }
     const Json parsed = Json::parse(value, nullptr, false);
+    if (key == "projectors" && !parsed.is_array()) {
+      doc[key] = projectorList(value);  // projectors=proj0,proj2
+      continue;
+    }
     doc[key] = parsed.is_discarded() ? Json(value) : parsed;
   }
   return doc.dump();

@@ -13,7 +13,7 @@ constexpr std::int64_t kRecoveryWaitNs = 100'000'000;  // between attempts to re
 }  // namespace
 
 hal::HalResult<void> Device::captureOnce() {
-  if (auto on = hal_.trigger.set(allProjectorsMask_); !on) {
+  if (auto on = hal_.trigger.set(rangeProjectorsMask_); !on) {
     ++counters_.captureErrors;
     return on;
   }

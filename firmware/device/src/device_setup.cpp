@@ -20,6 +20,7 @@ Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& op
       options_(options),
       depthUnitNm_(static_cast<std::uint32_t>(std::lround(board.config.depthUnitM * 1e9))),
       allProjectorsMask_(static_cast<std::uint32_t>((1U << board.rig.projectors.size()) - 1U)),
+      rangeProjectorsMask_(config::rangeProjectorsMask(board)),
       leadNs_(board.config.trigger.leadNs),
       startNs_(hal.clock.nowNs()),
       // Each camera's decoder may hold a slot while writing, besides the queued frames. Every
@@ -49,6 +50,13 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
     }
   }
   auto device = std::unique_ptr<Device>(new Device(board, hal, options));
+  if (device->rangeProjectorsMask_ == 0) {
+    return Fail("projectors: none of the chosen projectors is on the board");
+  }
+  if (auto power = hal.trigger.setPower(board.config.trigger.powerPercent); !power) {
+    return Fail(std::string("projector_power: ") + power.error().message);
+  }
+  const algo::Rig decodeRig = config::rangeRig(board);
   algo::PipelineOptions pipelineOptions = options.pipeline;
   pipelineOptions.depthUnitM = board.config.depthUnitM;
   device->cameras_.resize(rig.cameras.size());
@@ -58,7 +66,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
   device->workers_ = std::make_unique<WorkerPool>(threads - 1);
   for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
     const std::string& id = rig.cameras[i].id;
-    const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(i), pipelineOptions);
+    const auto setup = algo::prepareCameraPipeline(decodeRig, static_cast<int>(i), pipelineOptions);
     if (!setup) {
       return Fail("camera " + id + ": " + setup.error());
     }
@@ -80,6 +88,9 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
     if (!format) {
       return Fail("camera " + id + ": cannot configure " + board.config.cameras[i].device + ": " +
                   format.error().message);
+    }
+    if (const auto set = camera.setControls(board.config.cameras[i].controls); !set) {
+      return Fail("camera " + id + ": exposure or gain: " + set.error().message);
     }
     if (const auto started = camera.start(); !started) {
       return Fail("camera " + id + ": cannot start streaming: " + started.error().message);

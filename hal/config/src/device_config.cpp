@@ -17,10 +17,16 @@ namespace {
 
 using Json = nlohmann::json;
 
-constexpr std::array<std::string_view, 6> kSettingKeys = {
-    "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
-constexpr std::array<std::string_view, 7> kTopKeys = {
-    "format", "fps", "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
+constexpr std::array<std::string_view, 10> kSettingKeys = {
+    "fps",         "exposure_us", "gain",        "projectors",     "projector_power",
+    "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
+constexpr std::array<std::string_view, 11> kTopKeys = {
+    "format",      "fps",         "exposure_us", "gain",           "projectors", "projector_power",
+    "compression", "depth_min_m", "depth_max_m", "confidence_min", "rig"};
+// exposure_us and gain: the camera's own setting (stored as 0).
+constexpr std::string_view kCameraOwn = "camera";
+constexpr int kMaxExposureUs = 1'000'000;
+constexpr double kMaxGain = 64.0;
 constexpr std::array<std::string_view, 3> kCompressions = {"any", "rvl", "none"};
 
 constexpr std::array<FormatHint, 2> kOtherFormats = {
@@ -109,6 +115,73 @@ void readDepthWindow(FieldReader& r, const Json& doc, const Board& board,
   }
 }
 
+void readCameraControls(FieldReader& r, const Json& doc, DeviceConfig& out) {
+  if (const Json* v = r.find(doc, "exposure_us"); v != nullptr) {
+    if (v->is_string() && v->get_ref<const std::string&>() == kCameraOwn) {
+      out.exposureUs = 0;
+    } else {
+      int exposure = 0;
+      r.integer(doc, "", "exposure_us", 1, kMaxExposureUs,
+                "microseconds, or \"camera\" for the camera's own", exposure);
+      out.exposureUs = exposure;
+    }
+  }
+  if (const Json* v = r.find(doc, "gain"); v != nullptr) {
+    if (v->is_string() && v->get_ref<const std::string&>() == kCameraOwn) {
+      out.gain = 0.0;
+    } else if (const auto gain = r.number(*v, "gain", Range::kPositive); gain) {
+      if (*gain < 1.0 || *gain > kMaxGain) {
+        r.fail("gain", "must be from 1 to " + formatNumber(kMaxGain) +
+                           " (sensor gain), or \"camera\" for the camera's own, got " +
+                           formatNumber(*gain));
+      }
+      out.gain = *gain;
+    }
+  }
+}
+
+// A set of the board's projectors, kept in the rig's order whatever order the document lists.
+void readProjectors(FieldReader& r, const Json& doc, const Board& board, DeviceConfig& out) {
+  if (const Json* v = r.find(doc, "projectors"); v != nullptr) {
+    if (!v->is_array() || v->empty()) {
+      r.fail("projectors",
+             "must be a non-empty list of the board's projector ids, got " + describe(*v));
+      return;
+    }
+    std::vector<bool> chosen(board.rig.projectors.size(), false);
+    for (std::size_t i = 0; i < v->size() && r.ok(); ++i) {
+      const Json& id = (*v)[i];
+      const auto at = std::ranges::find_if(board.rig.projectors, [&](const algo::Projector& p) {
+        return id.is_string() && p.id == id.get_ref<const std::string&>();
+      });
+      if (at == board.rig.projectors.end()) {
+        std::vector<std::string_view> ids;
+        for (const auto& p : board.rig.projectors) {
+          ids.push_back(p.id);
+        }
+        r.fail(element("projectors", i),
+               describe(id) + " is not a projector of the board (" + joined(ids) + ")");
+      } else if (chosen[static_cast<std::size_t>(at - board.rig.projectors.begin())]) {
+        r.fail(element("projectors", i), describe(id) + " is listed twice");
+      } else {
+        chosen[static_cast<std::size_t>(at - board.rig.projectors.begin())] = true;
+      }
+    }
+    std::vector<std::string> ids;
+    for (std::size_t p = 0; p < chosen.size(); ++p) {
+      if (chosen[p]) {
+        ids.push_back(board.rig.projectors[p].id);
+      }
+    }
+    out.projectors = std::move(ids);
+  }
+  if (r.find(doc, "projector_power") != nullptr) {
+    int power = 0;
+    r.integer(doc, "", "projector_power", 1, 100, "percent of full", power);
+    out.projectorPower = power;
+  }
+}
+
 std::expected<DeviceConfig, FieldError> parseImpl(std::string_view text, const Board& board,
                                                   const DeviceConfig& stored) {
   auto parsed = parseDocument(text, kConfigDocument);
@@ -123,6 +196,8 @@ std::expected<DeviceConfig, FieldError> parseImpl(std::string_view text, const B
     r.integer(doc, "", "fps", 1, 120, "frames per second", fps);
     out.fps = fps;
   }
+  readCameraControls(r, doc, out);
+  readProjectors(r, doc, board, out);
   if (const Json* v = r.find(doc, "compression"); v != nullptr) {
     if (!v->is_string() ||
         std::ranges::find(kCompressions, v->get_ref<const std::string&>()) == kCompressions.end()) {
@@ -150,6 +225,18 @@ Json settingsJson(const DeviceConfig& c) {
   doc["format"] = kDeviceConfigFormat;
   if (c.fps) {
     doc["fps"] = *c.fps;
+  }
+  if (c.exposureUs) {
+    doc["exposure_us"] = *c.exposureUs == 0 ? Json(kCameraOwn) : Json(*c.exposureUs);
+  }
+  if (c.gain) {
+    doc["gain"] = *c.gain == 0.0 ? Json(kCameraOwn) : Json(*c.gain);
+  }
+  if (c.projectors) {
+    doc["projectors"] = *c.projectors;
+  }
+  if (c.projectorPower) {
+    doc["projector_power"] = *c.projectorPower;
   }
   if (c.compression) {
     doc["compression"] = kCompressions.at(static_cast<std::size_t>(*c.compression));
@@ -221,6 +308,10 @@ DeviceConfig merged(DeviceConfig stored, const DeviceConfig& change) {
     }
   };
   take(stored.fps, change.fps);
+  take(stored.exposureUs, change.exposureUs);
+  take(stored.gain, change.gain);
+  take(stored.projectors, change.projectors);
+  take(stored.projectorPower, change.projectorPower);
   take(stored.compression, change.compression);
   take(stored.depthMinM, change.depthMinM);
   take(stored.depthMaxM, change.depthMaxM);
@@ -236,6 +327,15 @@ std::string toJson(const DeviceConfig& config) {
 std::string effectiveJson(const DeviceConfig& config, const Board& board) {
   DeviceConfig all = config;
   all.fps = config.fps.value_or(board.config.cameras.front().format.fps);
+  all.exposureUs = config.exposureUs.value_or(0);
+  all.gain = config.gain.value_or(0.0);
+  if (!all.projectors) {
+    all.projectors.emplace();
+    for (const auto& p : board.rig.projectors) {
+      all.projectors->push_back(p.id);
+    }
+  }
+  all.projectorPower = config.projectorPower.value_or(100);
   all.compression = config.compression.value_or(Compression::kAny);
   all.depthMinM = config.depthMinM.value_or(0.0);
   // To the micrometre: 65535 units of 0.1 mm are 6.5535 m, not 6.5535000000000005.
@@ -252,10 +352,48 @@ Board appliedTo(const DeviceConfig& config, Board board) {
       camera.format.fps = *config.fps;
     }
   }
+  for (auto& camera : board.config.cameras) {
+    if (config.exposureUs) {
+      camera.controls.exposureUs =
+          *config.exposureUs == 0 ? std::nullopt : std::optional(*config.exposureUs);
+    }
+    if (config.gain) {
+      camera.controls.gain = *config.gain == 0.0 ? std::nullopt : std::optional(*config.gain);
+    }
+  }
+  if (config.projectors) {
+    board.config.trigger.rangeMask = 0;
+    for (std::size_t p = 0; p < board.rig.projectors.size(); ++p) {
+      if (std::ranges::find(*config.projectors, board.rig.projectors[p].id) !=
+          config.projectors->end()) {
+        board.config.trigger.rangeMask |= 1U << p;
+      }
+    }
+  }
+  board.config.trigger.powerPercent = config.projectorPower.value_or(100);
   if (config.rig) {
     board.rig = *config.rig;
   }
   return board;
+}
+
+std::uint32_t rangeProjectorsMask(const Board& board) {
+  const auto all =
+      static_cast<std::uint32_t>((std::uint64_t{1} << board.rig.projectors.size()) - 1U);
+  const std::uint32_t chosen = board.config.trigger.rangeMask;
+  return chosen == 0 ? all : chosen & all;
+}
+
+algo::Rig rangeRig(const Board& board) {
+  const std::uint32_t mask = rangeProjectorsMask(board);
+  algo::Rig rig = board.rig;
+  rig.projectors.clear();
+  for (std::size_t p = 0; p < board.rig.projectors.size(); ++p) {
+    if (((mask >> p) & 1U) != 0) {
+      rig.projectors.push_back(board.rig.projectors[p]);
+    }
+  }
+  return rig;
 }
 
 }  // namespace smx::config

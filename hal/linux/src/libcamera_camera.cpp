@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <system_error>
 #include <vector>
@@ -153,6 +154,13 @@ class LibcameraCamera final : public hal::Camera {
     const std::int64_t periodUs = 1'000'000 / format_.fps;
     const std::array<std::int64_t, 2> limits = {periodUs, periodUs};
     controls.set(lc::controls::FrameDurationLimits, lc::Span<const std::int64_t, 2>(limits));
+    if (wanted_.exposureUs) {
+      controls.set(lc::controls::AeEnable, false);
+      controls.set(lc::controls::ExposureTime, static_cast<std::int32_t>(*wanted_.exposureUs));
+    }
+    if (wanted_.gain) {
+      controls.set(lc::controls::AnalogueGain, static_cast<float>(*wanted_.gain));
+    }
     if (camera_->start(&controls) < 0) {
       unmapAll();
       return halFail(HalErrc::kIo, "libcamera cannot start the camera");
@@ -238,6 +246,47 @@ class LibcameraCamera final : public hal::Camera {
     return {};
   }
 
+  [[nodiscard]] hal::CameraControlSupport controlSupport() const override {
+    const lc::ControlInfoMap& info = camera_->controls();
+    return {.exposure = info.count(lc::controls::ExposureTime.id()) > 0,
+            .gain = info.count(lc::controls::AnalogueGain.id()) > 0};
+  }
+
+  // Sent with the start: libcamera takes controls per request, and the device sets them while
+  // the camera is stopped.
+  [[nodiscard]] hal::HalResult<void> setControls(const hal::CameraControls& controls) override {
+    if (state_ == CameraState::kStreaming) {
+      return halFail(HalErrc::kInvalidState, "exposure and gain are set while stopped");
+    }
+    const hal::CameraControlSupport support = controlSupport();
+    if ((controls.exposureUs && !support.exposure) || (controls.gain && !support.gain)) {
+      return halFail(HalErrc::kNotSupported, "the camera has no exposure or gain control");
+    }
+    const lc::ControlInfoMap& info = camera_->controls();
+    const auto outside = [&](const lc::ControlId& id, double value) {
+      const lc::ControlInfo& range = info.at(id.id());
+      const auto bound = [](const lc::ControlValue& v) {
+        switch (v.type()) {
+          case lc::ControlTypeFloat:
+            return static_cast<double>(v.get<float>());
+          case lc::ControlTypeInteger32:
+            return static_cast<double>(v.get<std::int32_t>());
+          case lc::ControlTypeInteger64:
+            return static_cast<double>(v.get<std::int64_t>());
+          default:
+            return std::numeric_limits<double>::quiet_NaN();  // no range given: unchecked
+        }
+      };
+      return value < bound(range.min()) || value > bound(range.max());
+    };
+    if ((controls.exposureUs && outside(lc::controls::ExposureTime, *controls.exposureUs)) ||
+        (controls.gain && outside(lc::controls::AnalogueGain, *controls.gain))) {
+      return halFail(HalErrc::kInvalidArgument, "a value outside the camera's control range");
+    }
+    wanted_ = controls;
+    return {};
+  }
+
   [[nodiscard]] hal::CameraState state() const override { return state_; }
   [[nodiscard]] std::string_view id() const override { return id_; }
 
@@ -315,6 +364,7 @@ class LibcameraCamera final : public hal::Camera {
 
   std::mutex mutex_;
   std::condition_variable ready_;
+  hal::CameraControls wanted_;           // sent with the next start
   std::vector<lc::Request*> completed_;  // a ring of completed requests, one slot per buffer
   std::size_t head_ = 0;
   std::size_t count_ = 0;

@@ -457,6 +457,11 @@ hal::HalResult<void> V4l2Camera::reopen() {
     return halFail(HalErrc::kNotSupported, "the reopened device cannot stream video");
   }
   fd_ = std::move(fd);
+  controls_ = V4l2Controls::query(io_, fd_.get());
+  // The same controls the device took before: a refusal now is the device not being back.
+  if (auto set = controls_.apply(io_, fd_.get(), wantedControls_); !set) {
+    return markLost(set.error().sysErrno != 0 ? set.error().sysErrno : ENODEV);
+  }
   if (state_ == CameraState::kUnconfigured) {
     return {};
   }
@@ -477,6 +482,17 @@ hal::HalResult<void> V4l2Camera::reopen() {
     resumeStreaming_ = false;  // streaming again, or failed for a reason a retry will not fix
   }
   return started;
+}
+
+hal::HalResult<void> V4l2Camera::setControls(const hal::CameraControls& controls) {
+  if (lost()) {
+    return halFail(HalErrc::kDisconnected, "the camera device is gone");
+  }
+  auto set = controls_.apply(io_, fd_.get(), controls);
+  if (set) {
+    wantedControls_ = controls;
+  }
+  return set;
 }
 
 void V4l2Camera::freeBuffers() {

@@ -306,7 +306,7 @@ class EmbreeRenderer final : public Renderer {
  private:
   struct FrameContext {
     const algo::Camera* camera = nullptr;
-    const std::vector<bool>* lit = nullptr;
+    std::vector<double> projectorWeight;  // per projector: 0 dark, else its power
     GroundTruthViews* truth = nullptr;
     std::vector<double> sampleOffsets;              // stratum centres within a pixel, per axis
     const std::vector<RgbF>* sampleRays = nullptr;  // cached directions, or null: undistort
@@ -322,14 +322,14 @@ class EmbreeRenderer final : public Renderer {
   [[nodiscard]] std::vector<double> exposureTimes(int frame) const;
   const std::vector<RgbF>* sampleRays(const FrameContext& ctx, int cameraIndex);
   void shadeRow(const FrameContext& ctx, int y);
-  void exposeRow(const algo::Camera& camera, int y);
+  void exposeRow(const algo::Camera& camera, double signalScale, int y);
   void writeTruth(const FrameContext& ctx, int x, int y) const;
   void addNoiseAndQuantise(const FrameRequest& request, algo::RgbView image) const;
 
   [[nodiscard]] std::optional<SurfacePoint> trace(const Vec3& origin, const Vec3& dir) const;
   [[nodiscard]] bool occluded(const Vec3& from, const Vec3& to) const;
   [[nodiscard]] std::optional<Illumination> illuminate(std::size_t p, const SurfacePoint& s) const;
-  [[nodiscard]] Vec3 radiance(const SurfacePoint& s, const std::vector<bool>& lit,
+  [[nodiscard]] Vec3 radiance(const SurfacePoint& s, const std::vector<double>& projectorWeight,
                               const Vec3& eye) const;
 
   algo::Rig rig_;
@@ -623,7 +623,7 @@ std::optional<Illumination> EmbreeRenderer::illuminate(std::size_t p, const Surf
   return il;
 }
 
-Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& lit,
+Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<double>& projectorWeight,
                               const Vec3& eye) const {
   const auto& lighting = scene_.lighting;
   const ObjectState& state = objects_[s.object];
@@ -631,14 +631,14 @@ Vec3 EmbreeRenderer::radiance(const SurfacePoint& s, const std::vector<bool>& li
   Vec3 irradiance = lighting.ambient;
   Vec3 gloss = Vec3::Zero();
   for (std::size_t p = 0; p < projectors_.size(); ++p) {
-    if (!lit[p]) {
+    if (projectorWeight[p] <= 0.0) {
       continue;
     }
     const auto il = illuminate(p, s);
     if (!il) {
       continue;
     }
-    double w = lighting.projectorPower * il->cosTheta;
+    double w = lighting.projectorPower * projectorWeight[p] * il->cosTheta;
     if (lighting.inverseSquare) {
       const double ratio = lighting.referenceDistanceM / il->distanceM;
       w *= ratio * ratio;
@@ -680,7 +680,7 @@ void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
           continue;  // beyond the range of the distortion model
         }
         if (const auto s = trace(centre, dir)) {
-          sum += radiance(*s, *ctx.lit, centre);
+          sum += radiance(*s, ctx.projectorWeight, centre);
         }
       }
     }
@@ -691,9 +691,9 @@ void EmbreeRenderer::shadeRow(const FrameContext& ctx, int y) {
 }
 
 // Vignetting, then crosstalk and gain: linear grey levels.
-void EmbreeRenderer::exposeRow(const algo::Camera& camera, int y) {
+void EmbreeRenderer::exposeRow(const algo::Camera& camera, double signalScale, int y) {
   const detail::Vignetting vignetting(camera, scene_.camera.vignetting);
-  const Mat3 response = scene_.camera.gain * 255.0 * scene_.camera.crosstalk;
+  const Mat3 response = signalScale * scene_.camera.gain * 255.0 * scene_.camera.crosstalk;
   for (int x = 0; x < camera.width; ++x) {
     const std::size_t i = pixelIndex(x, y, camera.width);
     const Vec3 grey = response * (vignetting.gain(x, y) * radiance_[i]);
@@ -747,7 +747,7 @@ void EmbreeRenderer::writeTruth(const FrameContext& ctx, int x, int y) const {
 }
 
 void EmbreeRenderer::addNoiseAndQuantise(const FrameRequest& request, algo::RgbView image) const {
-  const Vec3& sigma = scene_.camera.noiseSigma;
+  const Vec3 sigma = request.gain * scene_.camera.noiseSigma;
   const bool noisy = (sigma.array() > 0.0).any();
   // One stream per (seed, frame, camera), drawn in raster order after shading: the image does
   // not depend on how rows were shared between threads.
@@ -797,6 +797,16 @@ std::expected<void, std::string> EmbreeRenderer::check(const FrameRequest& reque
     return std::unexpected("lit has " + std::to_string(request.lit.size()) +
                            " entries; the rig has " + std::to_string(rig_.projectors.size()) +
                            " projector(s)");
+  }
+  if (!request.power.empty() && request.power.size() != request.lit.size()) {
+    return std::unexpected("power has " + std::to_string(request.power.size()) +
+                           " entries; the rig has " + std::to_string(rig_.projectors.size()) +
+                           " projector(s)");
+  }
+  const auto unit = [](double v) { return v >= 0.0 && v <= 1.0; };
+  if (!std::ranges::all_of(request.power, unit) || !(request.exposureScale > 0.0) ||
+      !(request.gain > 0.0) || !std::isfinite(request.exposureScale * request.gain)) {
+    return std::unexpected("projector power must be in [0, 1], exposure scale and gain positive");
   }
   if (truth == nullptr) {
     return {};
@@ -861,7 +871,11 @@ std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& requ
   }
   FrameContext ctx;
   ctx.camera = &rig_.cameras[static_cast<std::size_t>(request.camera)];
-  ctx.lit = &request.lit;
+  for (std::size_t p = 0; p < request.lit.size(); ++p) {
+    ctx.projectorWeight.push_back(!request.lit[p]         ? 0.0
+                                  : request.power.empty() ? 1.0
+                                                          : request.power[p]);
+  }
   ctx.truth = truth;
   const int n = scene_.supersampling;
   for (int i = 0; i < n; ++i) {
@@ -880,7 +894,8 @@ std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& requ
     ctx.firstTime = k == 0;
     forEachRow(height, [&](int y) { shadeRow(ctx, y); });
   }
-  forEachRow(height, [&](int y) { exposeRow(*ctx.camera, y); });
+  forEachRow(height,
+             [&](int y) { exposeRow(*ctx.camera, request.exposureScale * request.gain, y); });
   detail::gaussianBlur(linear_, width, height, scene_.camera.defocusSigmaPx,
                        detail::Border::kClampToEdge);
   detail::applyResponseGamma(linear_, scene_.camera.responseGamma);

@@ -114,7 +114,9 @@ std::expected<std::unique_ptr<SimBoardHal>, std::string> SimBoardHal::create(
   for (const auto& line : board.trigger.lines) {
     roles.push_back(line.role);
   }
-  out->trigger_ = std::make_unique<sim::SimTrigger>(std::move(roles), out->clock_);
+  // Replayed images were taken at one power: only rendered light can be dimmed.
+  out->trigger_ =
+      std::make_unique<sim::SimTrigger>(std::move(roles), out->clock_, out->replay_.empty());
   for (std::size_t i = 0; i < board.cameras.size(); ++i) {
     const CameraConfig& config = board.cameras[i];
     const sim::SimCameraSource source{.renderer = out->renderer_.get(),

@@ -127,10 +127,38 @@ hal::HalResult<void> SimCamera::produce(int buffer) {
   for (int p = 0; p < trigger_.count(); ++p) {
     request.lit.push_back(((lit >> p) & 1U) != 0);
   }
+  request.power.assign(request.lit.size(), trigger_.power() / 100.0);
+  request.exposureScale = static_cast<double>(exposureUs_) / kSimNominalExposureUs;
+  request.gain = gain_;
   auto view = *algo::RgbView::packed(pixels, format_.width, format_.height);
   if (!source_.renderer->render(request, view, nullptr)) {
     return halFail(HalErrc::kIo, "the simulator could not render the frame");
   }
+  return {};
+}
+
+hal::CameraControlSupport SimCamera::controlSupport() const {
+  // Replayed images were taken as they are: nothing changes their light.
+  const bool rendered = source_.replay == nullptr;
+  return {.exposure = rendered, .gain = rendered};
+}
+
+hal::HalResult<void> SimCamera::setControls(const hal::CameraControls& controls) {
+  const hal::CameraControlSupport support = controlSupport();
+  if ((controls.exposureUs && !support.exposure) || (controls.gain && !support.gain)) {
+    return hal::halFail(hal::HalErrc::kNotSupported,
+                        "a replaying simulated camera has no exposure or gain control");
+  }
+  if (controls.exposureUs &&
+      (*controls.exposureUs < 1 || *controls.exposureUs > kSimMaxExposureUs)) {
+    return hal::halFail(hal::HalErrc::kInvalidArgument,
+                        "the simulated camera's exposure is 1 us to 1 s");
+  }
+  if (controls.gain && !(*controls.gain >= 1.0 && *controls.gain <= kSimMaxGain)) {
+    return hal::halFail(hal::HalErrc::kInvalidArgument, "the simulated camera's gain is 1 to 16");
+  }
+  exposureUs_ = controls.exposureUs.value_or(kSimNominalExposureUs);
+  gain_ = controls.gain.value_or(1.0);
   return {};
 }
 

@@ -19,6 +19,12 @@
 // world, not the firmware), so allocation tests replay.
 namespace smx::sim {
 
+// The exposure a rendered frame has at exposure scale 1: the scene's light levels are what the
+// camera sees in this time at unity gain.
+inline constexpr int kSimNominalExposureUs = 10'000;
+inline constexpr int kSimMaxExposureUs = 1'000'000;
+inline constexpr double kSimMaxGain = 16.0;
+
 struct SimCameraSource {
   Renderer* renderer = nullptr;  // render live, or
   int rigCamera = 0;
@@ -38,6 +44,8 @@ class SimCamera final : public hal::Camera {
   [[nodiscard]] hal::HalResult<hal::CameraFrame> acquire(std::int64_t timeoutNs) override;
   [[nodiscard]] hal::HalResult<void> release(const hal::CameraFrame& frame) override;
   [[nodiscard]] hal::HalResult<void> recover() override;
+  [[nodiscard]] hal::HalResult<void> setControls(const hal::CameraControls& controls) override;
+  [[nodiscard]] hal::CameraControlSupport controlSupport() const override;
   [[nodiscard]] hal::CameraState state() const override { return state_; }
   [[nodiscard]] std::string_view id() const override { return id_; }
 
@@ -68,6 +76,8 @@ class SimCamera final : public hal::Camera {
   std::atomic<bool> connected_ = true;
   std::atomic<std::uint32_t> lastExposureMask_ = 0;
   std::atomic<std::uint64_t> delivered_ = 0;
+  std::atomic<int> exposureUs_ = kSimNominalExposureUs;
+  std::atomic<double> gain_ = 1.0;
 };
 
 }  // namespace smx::sim

@@ -16,6 +16,18 @@ hal::HalResult<void> SimTrigger::set(std::uint32_t activeMask) {
   return {};
 }
 
+hal::HalResult<void> SimTrigger::setPower(int percent) {
+  if (!dimmable_ && percent != 100) {
+    return hal::halFail(hal::HalErrc::kNotSupported,
+                        "a replaying simulated board cannot dim its projectors");
+  }
+  if (percent < 1 || percent > 100) {
+    return hal::halFail(hal::HalErrc::kInvalidArgument, "projector power must be 1 to 100 %");
+  }
+  power_ = percent;
+  return {};
+}
+
 std::uint32_t SimTrigger::active() const {
   const std::lock_guard lock(mutex_);
   return active_;

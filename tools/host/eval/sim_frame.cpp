@@ -70,8 +70,11 @@ SimFrame renderSimFrame(algo::Rig rig, const sim::Scene& scene, const SimRequest
   if (!renderer) {
     throw std::runtime_error(renderer.error());
   }
-  const sim::FrameRequest frame{request.camera, request.frame, std::vector<bool>(projectors, true),
-                                request.seed};
+  sim::FrameRequest frame;
+  frame.camera = request.camera;
+  frame.frame = request.frame;
+  frame.lit.assign(projectors, true);
+  frame.seed = request.seed;
   if (auto ok = (*renderer)->render(frame, f.image.view(), &truth); !ok) {
     throw std::runtime_error(ok.error());
   }

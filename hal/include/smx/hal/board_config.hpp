@@ -16,7 +16,8 @@ struct CameraConfig {
   std::string id;      // the rig's camera id
   std::string device;  // "/dev/video0", "libcamera:<name>", or "sim" on the simulated board
   CameraFormat format;
-  int buffers = 4;  // streaming buffers, 2..32
+  int buffers = 4;            // streaming buffers, 2..32
+  CameraControls controls{};  // the owner's exposure and gain (docs/config.md)
 };
 
 struct TriggerLineConfig {
@@ -29,6 +30,8 @@ struct TriggerLineConfig {
 struct TriggerConfig {
   std::vector<TriggerLineConfig> lines;  // in the rig's projector order
   std::int64_t leadNs = 0;               // lines active this long before the exposure starts
+  std::uint32_t rangeMask = 0;  // the projectors a range capture lights and decodes; 0: all
+  int powerPercent = 100;       // every projector's light, percent of full
 };
 
 struct NetworkConfig {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "smx/algo/image_view.hpp"
@@ -32,6 +33,19 @@ struct CameraFrame {
   algo::ConstRgbView image;
 };
 
+// Settings of the sensor a structured-light scanner must own: automatic exposure would follow
+// the projectors' patterns. Absent: the camera's own (as the driver starts it).
+struct CameraControls {
+  std::optional<int> exposureUs;  // exposure time, microseconds
+  std::optional<double> gain;     // sensor (analogue) gain, 1 = unity
+};
+
+// Which controls a camera has: what setControls() accepts.
+struct CameraControlSupport {
+  bool exposure = false;
+  bool gain = false;
+};
+
 enum class CameraState : std::uint8_t { kUnconfigured, kStopped, kStreaming };
 
 class Camera {
@@ -55,6 +69,16 @@ class Camera {
   [[nodiscard]] virtual HalResult<void> recover() {
     return halFail(HalErrc::kNotSupported, "this camera cannot recover");
   }
+
+  // Sets the controls that are present (while configured, streaming or not); a control the
+  // camera lacks or a value out of its range is kNotSupported / kInvalidArgument naming it.
+  [[nodiscard]] virtual HalResult<void> setControls(const CameraControls& controls) {
+    if (controls.exposureUs || controls.gain) {
+      return halFail(HalErrc::kNotSupported, "this camera has no exposure or gain control");
+    }
+    return {};
+  }
+  [[nodiscard]] virtual CameraControlSupport controlSupport() const { return {}; }
 
   [[nodiscard]] virtual CameraState state() const = 0;
   [[nodiscard]] virtual std::string_view id() const = 0;  // the rig's camera id

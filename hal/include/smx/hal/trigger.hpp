@@ -20,6 +20,16 @@ class TriggerLines {
   // Activates the lines whose bit is set in `activeMask` and deactivates the others.
   [[nodiscard]] virtual HalResult<void> set(std::uint32_t activeMask) = 0;
   [[nodiscard]] virtual std::uint32_t active() const = 0;
+  // Every projector's light, percent of full (1…100), on boards whose projector drivers can be
+  // dimmed; GPIO lines only switch, and refuse anything but 100.
+  [[nodiscard]] virtual bool dimmable() const { return false; }
+  [[nodiscard]] virtual HalResult<void> setPower(int percent) {
+    if (percent != 100) {
+      return halFail(HalErrc::kNotSupported,
+                     "the board's trigger lines only switch its projectors on and off");
+    }
+    return {};
+  }
 
  protected:
   TriggerLines() = default;

@@ -122,6 +122,7 @@ class Device {
   DeviceOptions options_;
   std::uint32_t depthUnitNm_;
   std::uint32_t allProjectorsMask_;
+  std::uint32_t rangeProjectorsMask_;  // lit for range captures: the owner's choice or all
   std::int64_t leadNs_;
   std::int64_t startNs_;
   std::vector<CameraSlot> cameras_;

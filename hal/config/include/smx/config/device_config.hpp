@@ -24,13 +24,18 @@ inline constexpr std::size_t kDeviceConfigMaxBytes = std::size_t{1} << 16U;
 // What range frames may travel as: the host picks from `kAny` (RVL unless told otherwise).
 enum class Compression : std::uint8_t { kAny, kRvl, kNone };
 
+// exposureUs and gain: 0 is "the camera's own", as set, so that a change can go back to it.
 struct DeviceConfig {
-  std::optional<int> fps;                  // camera frame rate, 1…120
-  std::optional<Compression> compression;  // what the device sends range frames as
-  std::optional<double> depthMinM;         // depths nearer are dropped
-  std::optional<double> depthMaxM;         // depths farther are dropped
-  std::optional<int> confidenceMin;        // depths less confident are dropped, 1…255
-  std::optional<algo::Rig> rig;            // the rig the device decodes with (a calibration)
+  std::optional<int> fps;         // camera frame rate, 1…120
+  std::optional<int> exposureUs;  // every camera's exposure time, 1…1 000 000 µs
+  std::optional<double> gain;     // every camera's sensor gain, 1…64
+  std::optional<std::vector<std::string>> projectors;  // lit and decoded, in the rig's order
+  std::optional<int> projectorPower;                   // percent of full, 1…100
+  std::optional<Compression> compression;              // what the device sends range frames as
+  std::optional<double> depthMinM;                     // depths nearer are dropped
+  std::optional<double> depthMaxM;                     // depths farther are dropped
+  std::optional<int> confidenceMin;                    // depths less confident are dropped, 1…255
+  std::optional<algo::Rig> rig;  // the rig the device decodes with (a calibration)
 };
 
 // The settings keys, in the order documents list them.
@@ -62,7 +67,14 @@ struct DeviceConfig {
 // Every setting as the device runs with it: `config`'s where set, the board's otherwise.
 [[nodiscard]] std::string effectiveJson(const DeviceConfig& config, const Board& board);
 
-// `board` as the device runs it with `config`: the frame rate of every camera and the rig.
+// `board` as the device runs it with `config`: every camera's frame rate and controls, the
+// projectors lit and their power, and the rig.
 [[nodiscard]] Board appliedTo(const DeviceConfig& config, Board board);
+
+// The projectors a range capture of `board` lights (bit i: the rig's projector i), and the rig
+// its range images are decoded with: only those projectors, so that the demultiplexer looks for
+// no pattern that is not there.
+[[nodiscard]] std::uint32_t rangeProjectorsMask(const Board& board);
+[[nodiscard]] algo::Rig rangeRig(const Board& board);
 
 }  // namespace smx::config

@@ -10,6 +10,7 @@
 
 #include "smx/algo/image_view.hpp"
 #include "smx/hal/camera.hpp"
+#include "smx/linux/v4l2_controls.hpp"
 #include "smx/linux/v4l2_io.hpp"
 
 // hal::Camera on a V4L2 single-planar capture device with mmap streaming (UVC webcams, CSI
@@ -44,6 +45,10 @@ class V4l2Camera final : public hal::Camera {
   [[nodiscard]] hal::HalResult<void> stop() override;
   [[nodiscard]] hal::HalResult<hal::CameraFrame> acquire(std::int64_t timeoutNs) override;
   [[nodiscard]] hal::HalResult<void> release(const hal::CameraFrame& frame) override;
+  [[nodiscard]] hal::HalResult<void> setControls(const hal::CameraControls& controls) override;
+  [[nodiscard]] hal::CameraControlSupport controlSupport() const override {
+    return controls_.support();
+  }
   [[nodiscard]] hal::CameraState state() const override { return state_; }
   [[nodiscard]] std::string_view id() const override { return id_; }
 
@@ -75,7 +80,8 @@ class V4l2Camera final : public hal::Camera {
         id_(std::move(id)),
         wantedBuffers_(buffers),
         fd_(std::move(fd)),
-        io_(io) {}
+        io_(io),
+        controls_(V4l2Controls::query(io, fd_.get())) {}
 
   [[nodiscard]] hal::HalResult<hal::CameraFormat> negotiate(const hal::CameraFormat& wanted);
   [[nodiscard]] hal::HalResult<void> startStreaming();
@@ -93,6 +99,8 @@ class V4l2Camera final : public hal::Camera {
   int wantedBuffers_;
   V4l2Fd fd_;  // invalid while the device is lost
   V4l2Io& io_;
+  V4l2Controls controls_;
+  hal::CameraControls wantedControls_;  // as set (reopen() sets them again)
   hal::CameraState state_ = hal::CameraState::kUnconfigured;
   bool resumeStreaming_ = false;  // streaming when the device was lost
   hal::CameraFormat wanted_;      // as asked for (reopen() asks again)

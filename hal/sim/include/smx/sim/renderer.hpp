@@ -33,10 +33,13 @@ struct GroundTruthViews {
 };
 
 struct FrameRequest {
-  int camera = 0;          // index into rig.cameras
-  int frame = 0;           // animation frame index
-  std::vector<bool> lit;   // per rig projector: on during the exposure
-  std::uint64_t seed = 0;  // noise seed; the same (seed, frame, camera) gives the same image
+  int camera = 0;               // index into rig.cameras
+  int frame = 0;                // animation frame index
+  std::vector<bool> lit;        // per rig projector: on during the exposure
+  std::uint64_t seed = 0;       // noise seed; the same (seed, frame, camera) gives the same image
+  std::vector<double> power{};  // per rig projector, 0…1 of the scene's power; empty: all full
+  double exposureScale = 1.0;   // exposure time over the scene's: scales the light collected
+  double gain = 1.0;            // sensor gain: scales the signal and the read noise
 };
 
 class Renderer {
