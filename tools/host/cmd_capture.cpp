@@ -11,6 +11,7 @@
 #include "calib_capture.hpp"
 #include "commands.hpp"
 #include "device_client.hpp"
+#include "device_option.hpp"
 #include "output_files.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/wire.hpp"
@@ -199,15 +200,6 @@ int runCapture(const CaptureOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
-// A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
-CLI::Validator deviceAddress() {
-  return {[](const std::string& text) {
-            const auto parsed = net::parseDeviceAddress(text, protocol::kDefaultPort);
-            return parsed ? std::string() : parsed.error();
-          },
-          "HOST[:PORT]"};
-}
-
 }  // namespace
 
 void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
@@ -216,7 +208,7 @@ void addCaptureCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       "capture", "Raw camera frames from a device with chosen projectors lit (PNG per camera)");
   cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
       ->required()
-      ->check(deviceAddress());
+      ->check(deviceAddressValidator());
   cmd->add_option("--out", opts->out, "Output directory")->required();
   auto* projectors = cmd->add_option(
       "--projectors", opts->projectors,

@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "device_client.hpp"
+#include "device_option.hpp"
 #include "output_files.hpp"
 #include "point_cloud.hpp"
 #include "smx/net/tcp_client.hpp"
@@ -405,15 +406,6 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
-// A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
-CLI::Validator deviceAddress() {
-  return {[](const std::string& text) {
-            const auto parsed = net::parseDeviceAddress(text, protocol::kDefaultPort);
-            return parsed ? std::string() : parsed.error();
-          },
-          "HOST[:PORT]"};
-}
-
 }  // namespace
 
 void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
@@ -421,7 +413,7 @@ void addInfoCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto* cmd = app.add_subcommand("info", "What a device reports: board, firmware, rig, counters");
   cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
       ->required()
-      ->check(deviceAddress());
+      ->check(deviceAddressValidator());
   cmd->callback([opts, &io, &exitCode] { exitCode = runInfo(*opts, io); });
 }
 
@@ -431,7 +423,7 @@ void addStreamCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       "stream", "Receive range images from a device: depth PNGs, PLY point clouds, a summary");
   cmd->add_option("--device", opts->device, "HOST[:PORT] of the device (default port 5555)")
       ->required()
-      ->check(deviceAddress());
+      ->check(deviceAddressValidator());
   cmd->add_option("--out", opts->out, "Output directory")->required();
   cmd->add_option("--frames", opts->frames, "Frames per camera to receive (default 10)")
       ->check(CLI::Range(1, 1000000));

@@ -155,10 +155,9 @@ void readProjectors(FieldReader& r, const Json& doc, const Board& board, DeviceC
         return id.is_string() && p.id == id.get_ref<const std::string&>();
       });
       if (at == board.rig.projectors.end()) {
-        std::vector<std::string_view> ids;
-        for (const auto& p : board.rig.projectors) {
-          ids.push_back(p.id);
-        }
+        std::vector<std::string_view> ids(board.rig.projectors.size());
+        std::ranges::transform(board.rig.projectors, ids.begin(),
+                               [](const algo::Projector& p) -> std::string_view { return p.id; });
         r.fail(element("projectors", i),
                describe(id) + " is not a projector of the board (" + joined(ids) + ")");
       } else if (chosen[static_cast<std::size_t>(at - board.rig.projectors.begin())]) {

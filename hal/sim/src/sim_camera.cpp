@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 
 namespace smx::sim {
@@ -154,7 +155,8 @@ hal::HalResult<void> SimCamera::setControls(const hal::CameraControls& controls)
     return hal::halFail(hal::HalErrc::kInvalidArgument,
                         "the simulated camera's exposure is 1 us to 1 s");
   }
-  if (controls.gain && !(*controls.gain >= 1.0 && *controls.gain <= kSimMaxGain)) {
+  if (controls.gain &&
+      (!std::isfinite(*controls.gain) || *controls.gain < 1.0 || *controls.gain > kSimMaxGain)) {
     return hal::halFail(hal::HalErrc::kInvalidArgument, "the simulated camera's gain is 1 to 16");
   }
   exposureUs_ = controls.exposureUs.value_or(kSimNominalExposureUs);
