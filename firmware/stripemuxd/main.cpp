@@ -151,8 +151,11 @@ int run(const Options& opts) {
 
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
   // Discovery is a convenience: a second device on this machine (tests) goes without it.
-  auto discovery = smx::net::DiscoveryResponder::create(
-      config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
+  // An owned device answers without its board name: paired hosts learn it in the capabilities,
+  // over the owner's channel (docs/security.md "Discovery").
+  auto discovery =
+      smx::net::DiscoveryResponder::create(config.network.bindAddress, smx::net::kDiscoveryPort,
+                                           tcpPort, owners ? std::string() : config.name);
   std::atomic<bool> stop = false;
   sigset_t signals;
   sigemptyset(&signals);
