@@ -91,6 +91,19 @@ grep -qaF "not paired" "$work/wire" || fail "the relay recorded nothing (refusal
 XDG_CONFIG_HOME=$work/host2 refused 3 "run stripemux pair" config --device "$device" get fps
 XDG_CONFIG_HOME=$work/host2 refused 2 "pairing is closed" pair --device "$device" --code "$code"
 
+# While the paired host streams, another is told the device is busy, but not by whom.
+"$tool" stream --device "$device" --frames 40 --timeout 60 --out "$work/s2" >/dev/null 2>&1 &
+streamer=$!
+for _ in $(seq 1 100); do
+  [ -n "$(ls -A "$work/s2" 2>/dev/null)" ] && break
+  sleep 0.1
+done
+XDG_CONFIG_HOME=$work/host2 refused 3 "the device is busy, held by another host" \
+  config --device "$device" get fps
+! grep -q "held by [0-9[]" "$work/err" || fail "the busy error names the holder: $(cat "$work/err")"
+kill "$streamer" 2>/dev/null || true
+wait "$streamer" 2>/dev/null || true
+
 # A hand-dropped key makes it a paired host (the owner's way), once it pairs its side too.
 XDG_CONFIG_HOME=$work/host2 "$tool" pair --show-key >"$work/state/hosts/laptop.pub"
 grep -q "^smx-x25519 [0-9a-f]\{64\} " "$work/state/hosts/laptop.pub" || fail "--show-key format"

@@ -168,7 +168,8 @@ std::expected<std::string, Failure> runPair(const PairOptions& opts) {
               << " s left); code: " << std::flush;
     std::getline(std::cin, code);
   }
-  if (code.size() < 6 || code.size() > 8 || code.find_first_not_of("0123456789") != code.npos) {
+  if (code.size() < 6 || code.size() > 8 ||
+      code.find_first_not_of("0123456789") != std::string::npos) {
     return Fail(Failure{kExitUsage, "the pairing code is 6 to 8 digits"});
   }
   const auto deviceKey = provePairing(*address, *identity, code);

@@ -61,10 +61,14 @@ std::expected<std::pair<MessageType, std::vector<std::byte>>, std::string> readC
   protocol::StreamParser parser(kClearMessageBytes);
   (void)parser.feed(message);
   const auto next = parser.next();
-  if (!next || !next->has_value()) {
-    return Fail(std::string("a malformed answer: ") + (next ? "incomplete" : next.error().message));
+  if (!next) {
+    return Fail(std::string("a malformed answer: ") + next.error().message);
   }
-  const protocol::Message& m = **next;
+  const std::optional<protocol::Message>& parsed = *next;
+  if (!parsed.has_value()) {
+    return Fail("a malformed answer: incomplete");
+  }
+  const protocol::Message& m = *parsed;
   return std::pair{m.type, std::vector<std::byte>(m.payload.begin(), m.payload.end())};
 }
 

@@ -31,11 +31,12 @@ std::expected<fs::path, std::string> devicesDir(bool create) {
 }  // namespace
 
 std::expected<fs::path, std::string> stripemuxConfigDir() {
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): the tool never sets its environment
   const char* xdg = std::getenv("XDG_CONFIG_HOME");
   if (xdg != nullptr && *xdg == '/') {
     return fs::path(xdg) / "stripemux";
   }
-  const char* home = std::getenv("HOME");
+  const char* home = std::getenv("HOME");  // NOLINT(concurrency-mt-unsafe): as above
   if (home == nullptr || *home != '/') {
     return std::unexpected(std::string("neither XDG_CONFIG_HOME nor HOME names a directory"));
   }

@@ -1,5 +1,6 @@
 #include "smx/device/owners.hpp"
 
+#include <algorithm>
 #include <system_error>
 
 #include "smx/protocol/secure_keys.hpp"
@@ -25,16 +26,13 @@ std::expected<Owners, std::string> Owners::open(const fs::path& stateDir, bool p
 
 bool Owners::isPaired(const protocol::Key32& host) const {
   std::error_code error;
-  for (const auto& entry : fs::directory_iterator(hostsDir_, error)) {
+  return std::ranges::any_of(fs::directory_iterator(hostsDir_, error), [&](const auto& entry) {
     if (entry.path().extension() != ".pub") {
-      continue;
+      return false;
     }
     const auto key = protocol::readPublicKeyFile(entry.path());
-    if (key && *key == host) {
-      return true;
-    }
-  }
-  return false;
+    return key && *key == host;
+  });
 }
 
 std::size_t Owners::pairedHosts() const {

@@ -65,11 +65,16 @@ std::optional<MessageType> SecureLink::readHandshake(std::int64_t deadlineNs) {
   handshakeParser_.reset();
   (void)handshakeParser_.feed(std::span(handshake_).first(header.size() + length));
   const auto next = handshakeParser_.next();
-  if (!next || !next->has_value()) {
+  if (!next) {
+    refuse(protocol::ErrorCode::kBadRequest, next.error().message, deadlineNs);
+    return std::nullopt;
+  }
+  const std::optional<protocol::Message>& parsed = *next;
+  if (!parsed.has_value()) {
     refuse(protocol::ErrorCode::kBadRequest, "a malformed handshake message", deadlineNs);
     return std::nullopt;
   }
-  const protocol::Message& message = **next;
+  const protocol::Message& message = *parsed;
   hsPayloadSize_ = message.payload.size();
   std::memcpy(hsPayload_.data(), message.payload.data(), hsPayloadSize_);
   return message.type;
@@ -219,13 +224,15 @@ void SecureLink::servePairRequest(std::int64_t deadlineNs) {
   const protocol::Key32& identity = owners_.identity().publicKey;
   const auto keys =
       protocol::pakeFinish(share, request->element, *request, share.element, identity);
+  if (!keys) {
+    refuse(protocol::ErrorCode::kBadRequest, "pair-request: an invalid element", deadlineNs);
+    return;
+  }
   std::array<std::byte, 256> out{};
   const auto challenge =
-      keys ? protocol::encode(protocol::PairChallenge{share.element, identity, keys->deviceProof},
-                              out)
-           : protocol::protocolFail(protocol::ProtocolErrc::kMalformed, "an invalid element");
+      protocol::encode(protocol::PairChallenge{share.element, identity, keys->deviceProof}, out);
   if (!challenge) {
-    refuse(protocol::ErrorCode::kBadRequest, challenge.error().message, deadlineNs);
+    refuse(protocol::ErrorCode::kInternal, challenge.error().message, deadlineNs);
     return;
   }
   if (!writeAll(*challenge, deadlineNs) || readHandshake(deadlineNs) != MessageType::kPairProof) {

@@ -48,7 +48,7 @@ class SecureLink final : public hal::Link {
   [[nodiscard]] bool writeAll(std::span<const std::byte> bytes, std::int64_t deadlineNs);
   [[nodiscard]] bool flush();
   // Sends a clear-text error and drops the host.
-  void refuse(protocol::ErrorCode code, std::string_view text, std::int64_t deadlineNs);
+  void refuse(protocol::ErrorCode code, std::string_view reason, std::int64_t deadlineNs);
   [[nodiscard]] bool openSession(std::int64_t deadlineNs);
   void printNewCode(std::int64_t nowNs);
   void servePairBegin(std::int64_t deadlineNs);
