@@ -8,14 +8,20 @@
 #include <csignal>
 #include <cstdio>
 #include <ctime>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include "settings.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/device/device.hpp"
+#include "smx/device/owners.hpp"
+#include "smx/device/secure_link.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/discovery.hpp"
 #include "smx/net/tcp_client.hpp"
+#include "smx/net/tcp_link.hpp"
+#include "smx/protocol/secure_keys.hpp"
 
 namespace {
 
@@ -28,6 +34,8 @@ struct Options {
   std::string scene;
   std::string replay;
   std::string state;
+  bool pair = false;
+  bool open = false;
   int fps = 0;
   std::uint64_t frames = 0;
   double statusEveryS = 5;
@@ -117,14 +125,38 @@ int run(const Options& opts) {
     std::fprintf(stderr, "stripemuxd: %s\n", settings.error().c_str());
     return 1;
   }
+  // The owner's channel (docs/security.md): with a state directory only paired hosts are served.
+  std::optional<smx::device::Owners> owners;
+  std::unique_ptr<smx::device::SecureLink> secureLink;
+  if (!opts.state.empty() && !opts.open) {
+    auto opened = smx::device::Owners::open(opts.state, opts.pair);
+    if (!opened) {
+      std::fprintf(stderr, "stripemuxd: %s\n", opened.error().c_str());
+      return 1;
+    }
+    owners.emplace(std::move(*opened));
+    const smx::hal::Hal devices = (*hal)->hal();
+    secureLink = std::make_unique<smx::device::SecureLink>(devices.link, *owners, devices.clock);
+    if (auto* tcp = dynamic_cast<smx::net::TcpLink*>(&devices.link)) {
+      tcp->hideHolder();
+    }
+  }
+  const auto deviceHal = [&] {
+    const smx::hal::Hal devices = (*hal)->hal();
+    return secureLink ? smx::hal::Hal{devices.cameras, devices.trigger, *secureLink, devices.clock}
+                      : devices;
+  };
   smx::device::DeviceOptions base;
   base.firmwareVersion = SMX_VERSION;
   base.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
 
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
   // Discovery is a convenience: a second device on this machine (tests) goes without it.
-  auto discovery = smx::net::DiscoveryResponder::create(
-      config.network.bindAddress, smx::net::kDiscoveryPort, tcpPort, config.name);
+  // An owned device answers without its board name: paired hosts learn it in the capabilities,
+  // over the owner's channel (docs/security.md "Discovery").
+  auto discovery =
+      smx::net::DiscoveryResponder::create(config.network.bindAddress, smx::net::kDiscoveryPort,
+                                           tcpPort, owners ? std::string() : config.name);
   std::atomic<bool> stop = false;
   sigset_t signals;
   sigemptyset(&signals);
@@ -144,7 +176,7 @@ int run(const Options& opts) {
       return settings->change(request);
     };
     const smx::config::Board running = settings->board();
-    auto device = Device::create(running, (*hal)->hal(), options);
+    auto device = Device::create(running, deviceHal(), options);
     if (!device && started) {
       // Checked before they were stored, yet refused (a camera that cannot run at that rate):
       // the settings before are the ones the device last ran with.
@@ -153,7 +185,7 @@ int run(const Options& opts) {
       if (auto reverted = settings->revert(); !reverted) {
         std::printf("%s\n", reverted.error().c_str());
       }
-      device = Device::create(settings->board(), (*hal)->hal(), settings->deviceOptions(base));
+      device = Device::create(settings->board(), deviceHal(), settings->deviceOptions(base));
     }
     if (!device) {
       std::fprintf(stderr, "stripemuxd: board %s: %s\n", config.name.c_str(),
@@ -173,6 +205,15 @@ int run(const Options& opts) {
                   smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
       if (!discovery) {
         std::printf("discovery off: %s\n", discovery.error().c_str());
+      }
+      if (owners) {
+        std::printf("owner's channel: device key %s, %zu paired hosts\n",
+                    smx::protocol::fingerprint(owners->identity().publicKey).c_str(),
+                    owners->pairedHosts());
+        secureLink->announcePairing();
+      } else {
+        std::printf("%s: anyone on the network can use this device\n",
+                    opts.open ? "--open" : "no --state");
       }
     }
     std::printf("settings: %s\n", settings->describe().c_str());
@@ -206,7 +247,13 @@ int parseAndRun(int argc, char** argv) {
   app.add_option("--replay", opts.replay,
                  "simulated board: replay <dir>/<camera-id>_<n>.png instead of rendering");
   app.add_option("--state", opts.state,
-                 "state directory: the owner's settings (config.json), kept across restarts");
+                 "state directory: the owner's settings (config.json), keys and paired hosts, kept "
+                 "across restarts; the device then serves paired hosts only");
+  app.add_flag("--pair", opts.pair,
+               "with --state: open pairing (print a code) although hosts are paired already");
+  app.add_flag("--open", opts.open,
+               "with --state: serve any host in the clear, no pairing (development and tests; "
+               "never on a real board)");
   app.add_option("--fps", opts.fps, "camera frame rate (overrides the board)")
       ->check(CLI::Range(1, 1000));
   app.add_option("--frames", opts.frames, "stop after this many captures (0: run until SIGTERM)");

@@ -279,8 +279,22 @@ def bundle_seeds():
           manifest([("a", "0644", b"x"), ("a/b", "0644", b"y")]).encode() + b"\0xy")
 
 
+def pairing_seeds():
+    """[type, length u16, payload] records of messages 21-28 (docs/security.md)."""
+    def record(kind, payload):
+        return struct.pack("<BH", kind, len(payload)) + payload
+    key = bytes(range(32))
+    write("pairing", "secure_hello_accept.bin", record(21, key + key) + record(22, key * 2))
+    write("pairing", "pairing_exchange.bin",
+          record(27, b"") + record(28, bytes([3]) + struct.pack("<H", 300) + bytes([8])) +
+          record(23, key * 2) + record(24, key * 3) + record(25, key) + record(26, b""))
+    write("pairing", "short_and_long.bin", record(21, key) + record(24, key * 3 + b"x") +
+          record(28, bytes([4, 0, 0, 9])))
+
+
 def main():
-    for target in ("protocol", "rig", "board", "scene", "png", "range_frame", "config", "bundle"):
+    for target in ("protocol", "rig", "board", "scene", "png", "range_frame", "config", "bundle",
+                   "pairing"):
         shutil.rmtree(CORPUS / target, ignore_errors=True)
         (CORPUS / target).mkdir(parents=True)
     FILES.mkdir(exist_ok=True)
@@ -291,6 +305,7 @@ def main():
     range_seeds()
     config_seeds()
     bundle_seeds()
+    pairing_seeds()
 
 
 if __name__ == "__main__":

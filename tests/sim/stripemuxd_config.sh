@@ -29,7 +29,7 @@ mv "$work/frames/cam1.png" "$work/frames/cam1_0.png"
 start() {
   : >"$work/log"
   env "$@" "$daemon" --board "$src/boards/sim" --replay "$work/frames" --port 0 --fps 5 \
-    --state "$state" >"$work/log" 2>&1 &
+    --state "$state" --open >"$work/log" 2>&1 &
   pid=$!
   for _ in $(seq 1 200); do
     grep -q "^settings: " "$work/log" && break

@@ -28,6 +28,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addKeygenCommand(app, io, exitCode);
   addBundleCommand(app, io, exitCode);
   addVerifyBundleCommand(app, io, exitCode);
+  addPairCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {
@@ -52,7 +53,9 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
       io.out << "\n";
       for (const auto& device : *found) {
         // Discovery answers are unauthenticated: a spoofed one must not steer the terminal.
-        io.out << "  " << printable(device.address) << "  board " << printable(device.board)
+        io.out << "  " << printable(device.address) << "  "
+               << (device.board.empty() ? std::string("owned (stripemux pair)")
+                                        : "board " + printable(device.board))
                << "\n";
       }
     }

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "pairing_store.hpp"
 #include "smx/config/identifier.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/hal/steady_clock.hpp"
@@ -55,7 +56,7 @@ std::optional<std::string> announcementMismatch(const DeviceInfo& info) {
 
 }  // namespace
 
-DeviceClient::DeviceClient(net::TcpClient socket, std::string address)
+DeviceClient::DeviceClient(DeviceSocket socket, std::string address)
     : socket_(std::move(socket)),
       parser_(std::make_unique<protocol::StreamParser>(protocol::kMaxPayloadBytes)),
       out_(4096) {
@@ -69,11 +70,30 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
     return Fail("--device: " + parsed.error());
   }
   const std::string where = net::toString(*parsed);
+  // A device this host paired with is spoken to over the owner's channel only, never in the
+  // clear (docs/security.md "Choosing the channel").
+  const auto pairedKey = pairedDeviceKey(*parsed);
+  if (!pairedKey) {
+    return Fail(pairedKey.error());
+  }
   auto socket = net::TcpClient::connect(*parsed, timeout, kReceiveBufferBytes);
   if (!socket) {
     return Fail(socket.error());
   }
-  DeviceClient client(std::move(*socket), where);
+  auto stream = [&]() -> std::expected<DeviceSocket, std::string> {
+    if (!pairedKey->has_value()) {
+      return DeviceSocket::plain(std::move(*socket));
+    }
+    auto identity = hostIdentity();
+    if (!identity) {
+      return Fail(identity.error());
+    }
+    return DeviceSocket::secure(std::move(*socket), *identity, **pairedKey, timeout);
+  }();
+  if (!stream) {
+    return Fail(where + ": " + stream.error());
+  }
+  DeviceClient client(std::move(*stream), where);
   const auto hello =
       client.send(protocol::encode(protocol::Hello{"stripemux " SMX_VERSION}, client.out_));
   // A busy device closes at once; its error may be waiting even when the hello failed.
@@ -96,6 +116,13 @@ std::expected<DeviceClient, std::string> DeviceClient::connect(const std::string
   }
   const auto& [type, payload] = *answer;
   if (type == MessageType::kError) {
+    const auto error = protocol::decodeError(payload);
+    if (error && error->code == protocol::ErrorCode::kNotPaired) {
+      return Fail(where +
+                  ": this host is not paired with the device, which serves its owner's "
+                  "hosts only: run stripemux pair --device " +
+                  where);
+    }
     return Fail(where + ": " + deviceError(payload));
   }
   const auto caps =

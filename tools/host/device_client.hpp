@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "device_socket.hpp"
 #include "range_frame.hpp"
 #include "raw_frames.hpp"
 #include "smx/algo/rig.hpp"
@@ -68,12 +69,14 @@ class DeviceClient {
   // with, and restarts with them (this connection ends). A refusal names the setting.
   [[nodiscard]] std::expected<std::string, std::string> setConfig(
       protocol::SetConfigMode mode, std::string_view json, std::chrono::milliseconds timeout);
+  // The owner's encrypted channel (a device this host paired with), or the clear.
+  [[nodiscard]] bool encrypted() const { return socket_.encrypted(); }
   // Bad messages from the device so far (skipped).
   [[nodiscard]] std::uint64_t protocolErrors() const { return parser_->counters().errors; }
   void close() { socket_.close(); }
 
  private:
-  DeviceClient(net::TcpClient socket, std::string address);
+  DeviceClient(DeviceSocket socket, std::string address);
   [[nodiscard]] std::expected<void, std::string> send(
       const protocol::ProtocolResult<std::span<const std::byte>>& message);
   // The config message that answers a get-config or set-config.
@@ -84,7 +87,7 @@ class DeviceClient {
       std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>>, std::string>
   nextMessage(std::chrono::milliseconds timeout);
 
-  net::TcpClient socket_;
+  DeviceSocket socket_;
   std::unique_ptr<protocol::StreamParser> parser_;
   std::vector<std::byte> out_;
   DeviceInfo info_;

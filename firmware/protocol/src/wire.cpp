@@ -9,8 +9,10 @@ namespace smx::protocol {
 
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
-  return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-         value <= static_cast<std::uint8_t>(MessageType::kSetConfig);
+  return (value >= static_cast<std::uint8_t>(MessageType::kHello) &&
+          value <= static_cast<std::uint8_t>(MessageType::kSetConfig)) ||
+         (value >= static_cast<std::uint8_t>(MessageType::kSecureHello) &&
+          value <= static_cast<std::uint8_t>(MessageType::kPairReady));
 }
 
 const char* toString(MessageType type) {
@@ -43,6 +45,22 @@ const char* toString(MessageType type) {
       return "config";
     case MessageType::kSetConfig:
       return "set-config";
+    case MessageType::kSecureHello:
+      return "secure-hello";
+    case MessageType::kSecureAccept:
+      return "secure-accept";
+    case MessageType::kPairRequest:
+      return "pair-request";
+    case MessageType::kPairChallenge:
+      return "pair-challenge";
+    case MessageType::kPairProof:
+      return "pair-proof";
+    case MessageType::kPairDone:
+      return "pair-done";
+    case MessageType::kPairBegin:
+      return "pair-begin";
+    case MessageType::kPairReady:
+      return "pair-ready";
   }
   return "unknown";
 }

@@ -131,7 +131,8 @@ void TcpLink::refusePending() {
     }
     ++refused_;
     std::array<char, 128> text{};
-    std::snprintf(text.data(), text.size(), "held by %s for %lld s", clientAddress_.data(),
+    std::snprintf(text.data(), text.size(), "held by %s for %lld s",
+                  hideHolder_ ? "another host" : clientAddress_.data(),
                   static_cast<long long>((now - clientSinceNs_) / 1'000'000'000));
     std::array<std::byte, 256> message{};
     const auto busy =

@@ -44,6 +44,15 @@ enum class MessageType : std::uint8_t {
   kGetConfig = 12,   // host → device: the settings the device runs with
   kConfig = 13,      // device → host: its settings (answer to get-config and set-config)
   kSetConfig = 14,   // host → device: change settings (stored, then the device restarts)
+  // The owner's channel (docs/security.md), sent in the clear before encryption starts.
+  kSecureHello = 21,    // host → device: ephemeral and static key of a paired host
+  kSecureAccept = 22,   // device → host: ephemeral and static key of the device
+  kPairRequest = 23,    // host → device: its code-derived element and static key
+  kPairChallenge = 24,  // device → host: its element, static key and proof of the code
+  kPairProof = 25,      // host → device: its proof of the code
+  kPairDone = 26,       // device → host: the host's key is stored
+  kPairBegin = 27,      // host → device: open a pairing code (printed on the device's console)
+  kPairReady = 28,      // device → host: a code is open, its attempts and seconds left
 };
 
 [[nodiscard]] bool isKnown(MessageType type);

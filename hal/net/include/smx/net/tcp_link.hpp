@@ -34,6 +34,9 @@ class TcpLink final : public hal::Link {
 
   // Hosts turned away because one was already connected.
   [[nodiscard]] std::uint64_t refusedClients() const { return refused_; }
+  // The busy error then says "another host" instead of its address: an owned device tells an
+  // unauthenticated peer nothing about who uses it (docs/security.md).
+  void hideHolder() { hideHolder_ = true; }
 
  private:
   // A turned-away host's connection: its `busy` error is sent and our side shut down; it is
@@ -54,6 +57,7 @@ class TcpLink final : public hal::Link {
   std::uint16_t port_;
   int sendBufferBytes_;
   std::uint64_t refused_ = 0;
+  bool hideHolder_ = false;
   std::array<char, 64> clientAddress_{};  // "a.b.c.d:port" or "[v6]:port"
   std::int64_t clientSinceNs_ = 0;        // CLOCK_MONOTONIC
   std::array<Refused, 4> refusedOpen_;
