@@ -78,9 +78,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<std::byte> stream;
   for (std::size_t at = 0; at + 3 <= input.size();) {
     const auto type = static_cast<MessageType>(input[at]);
-    const std::size_t length = std::min<std::size_t>(
-        std::to_integer<std::size_t>(input[at + 1]) | (std::to_integer<std::size_t>(input[at + 2]) << 8U),
-        input.size() - at - 3);
+    const std::size_t length =
+        std::min<std::size_t>(std::to_integer<std::size_t>(input[at + 1]) |
+                                  (std::to_integer<std::size_t>(input[at + 2]) << 8U),
+                              input.size() - at - 3);
     std::vector<std::byte> message(kHeaderBytes + length);
     std::memcpy(message.data() + kHeaderBytes, input.data() + at + 3, length);
     if (const auto sealed = sealMessage(message, type, length)) {
