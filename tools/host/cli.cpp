@@ -28,6 +28,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addKeygenCommand(app, io, exitCode);
   addBundleCommand(app, io, exitCode);
   addVerifyBundleCommand(app, io, exitCode);
+  addFlashCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -21,5 +21,6 @@ void addConfigCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addKeygenCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

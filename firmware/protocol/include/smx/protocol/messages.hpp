@@ -137,6 +137,7 @@ enum class ErrorCode : std::uint16_t {
   kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
   kBusy = 3,        // another host is connected
   kInternal = 4,
+  kUpdateRefused = 6,  // a firmware bundle was refused (the text says why); nothing was installed
 };
 
 struct ErrorMessage {
