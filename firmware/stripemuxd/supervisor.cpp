@@ -120,8 +120,9 @@ std::optional<Firmware> decide(const SuperviseOptions& o, bool& trial) {
       }
       continue;
     }
-    if (*active && !complete(o, **active)) {
-      if (!rollBack(o, *record, "slot " + **active + " is incomplete")) {
+    const std::optional<std::string>& slot = *active;
+    if (slot.has_value() && !complete(o, *slot)) {
+      if (!rollBack(o, *record, "slot " + *slot + " is incomplete")) {
         return std::nullopt;
       }
       continue;
@@ -153,6 +154,7 @@ pid_t start(const Firmware& firmware, const SuperviseOptions& o) {
                                    "--supervised"};
   args.insert(args.end(), o.daemon.begin(), o.daemon.end());
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (auto& arg : args) {
     argv.push_back(arg.data());
   }

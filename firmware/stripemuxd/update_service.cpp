@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <optional>
 #include <system_error>
 
 #include "smx/device/state_file.hpp"
@@ -40,10 +41,11 @@ UpdateService::UpdateService(fs::path stateDir, std::string board, bool supervis
     return;
   }
   const auto active = update::activeSlot(dir_);
-  if (!active || !*active) {
+  const std::optional<std::string> slot = active.value_or(std::nullopt);
+  if (!slot.has_value()) {
     return;
   }
-  slot_ = **active;
+  slot_ = *slot;
   if (const auto manifest = update::readSlotManifest(dir_, slot_)) {
     version_ = update::toString(manifest->version);
   }

@@ -25,11 +25,12 @@ std::optional<FlashFailure> DeviceClient::flashRefusal() {
     if (!message) {
       return FlashFailure{false, message.error()};
     }
-    if (!message->has_value()) {
+    const auto& got = *message;
+    if (!got.has_value()) {
       return std::nullopt;
     }
-    if ((*message)->first == MessageType::kError) {
-      return failure((*message)->second);
+    if (got->first == MessageType::kError) {
+      return failure(got->second);
     }
   }
 }
@@ -69,11 +70,12 @@ std::expected<void, FlashFailure> DeviceClient::flash(
     if (!next) {
       return fail(next.error());
     }
-    if (!next->has_value()) {
+    const auto& got = *next;
+    if (!got.has_value()) {
       return fail("the device did not finish the installation within " +
                   std::to_string(timeout.count() / 1000) + " s");
     }
-    const auto& [type, payload] = **next;
+    const auto& [type, payload] = *got;
     if (type == MessageType::kError) {
       return std::unexpected(failure(payload));
     }
@@ -104,11 +106,12 @@ std::expected<UpdateStatusReport, std::string> DeviceClient::updateStatus(
     if (!next) {
       return std::unexpected(next.error());
     }
-    if (!next->has_value()) {
+    const auto& got = *next;
+    if (!got.has_value()) {
       return std::unexpected("no answer to get-update-status within " +
                              std::to_string(timeout.count()) + " ms");
     }
-    const auto& [type, payload] = **next;
+    const auto& [type, payload] = *got;
     if (type == MessageType::kError) {
       return std::unexpected(failure(payload).message);
     }

@@ -101,11 +101,12 @@ void Device::onFlash(const protocol::Message& message) {
     }
     default: {
       const UpdateStatusInfo status = hooks.status();
+      const std::string_view reason = status.reason;
       std::array<std::byte, 2048> reply{};
-      send(protocol::encode(protocol::UpdateStatus{status.outcome, status.runningSlot,
-                                                   status.runningVersion, status.updateVersion,
-                                                   std::string_view(status.reason).substr(0, 1024)},
-                            reply));
+      send(protocol::encode(
+          protocol::UpdateStatus{status.outcome, status.runningSlot, status.runningVersion,
+                                 status.updateVersion, reason.substr(0, 1024)},
+          reply));
       return;
     }
   }

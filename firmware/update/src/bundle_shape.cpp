@@ -8,7 +8,7 @@ namespace smx::update {
 std::expected<void, UpdateError> checkBundleShape(std::span<const std::byte> bytes) {
   const auto matches = [&](std::size_t at, const std::array<char, 8>& magic) {
     return std::ranges::equal(bytes.subspan(at, magic.size()), magic,
-                              [](std::byte b, char c) { return b == std::byte(c); });
+                              [](std::byte b, char c) { return b == static_cast<std::byte>(c); });
   };
   if (bytes.size() < kHeaderSize + kTrailerSize) {
     return std::unexpected(UpdateError{

@@ -15,7 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr std::size_t kMaxRecordSize = 64 * 1024;
+constexpr std::size_t kMaxRecordSize = std::size_t{64} * 1024;
 
 std::unexpected<UpdateError> malformed(const std::string& where, const std::string& what) {
   return std::unexpected(UpdateError{UpdateReason::kMalformed, where + ": " + what});
@@ -47,7 +47,7 @@ std::expected<std::string, UpdateError> slotField(const Json& json, const char* 
   }
   const auto value = it->get<std::string>();
   if (!value.empty() && !isSlotId(value)) {
-    return malformed(std::string("boot.json: ") + key, "must be \"\", \"a\" or \"b\"");
+    return malformed(std::string("boot.json: ") + key, R"(must be "", "a" or "b")");
   }
   return value;
 }
@@ -96,7 +96,7 @@ std::expected<BootRecord, UpdateError> parseBootRecord(std::string_view text) {
     return malformed("boot.json", "not a JSON object");
   }
   if (json.value("format", "") != "stripemux-boot/1") {
-    return malformed("boot.json: format", "must be \"stripemux-boot/1\"");
+    return malformed("boot.json: format", R"(must be "stripemux-boot/1")");
   }
   BootRecord record;
   auto previous = slotField(json, "previous");
@@ -128,7 +128,7 @@ std::expected<BootRecord, UpdateError> parseBootRecord(std::string_view text) {
   } else if (*outcome == "rolled back") {
     record.outcome = UpdateOutcome::kRolledBack;
   } else if (*outcome != "none") {
-    return malformed("boot.json: outcome", "must be \"none\", \"installed\" or \"rolled back\"");
+    return malformed("boot.json: outcome", R"(must be "none", "installed" or "rolled back")");
   }
   return record;
 }
