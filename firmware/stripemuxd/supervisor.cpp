@@ -235,7 +235,9 @@ int supervise(const SuperviseOptions& o) {
       say("cannot start the firmware");
       return 1;
     }
-    device::crashPoint(trial ? "supervise.trial-started" : "supervise.started");
+    if (trial) {
+      device::crashPoint("supervise.trial-started");
+    }
     const double started = nowS();
     int status = 0;
     bool stopping = false;
@@ -248,7 +250,6 @@ int supervise(const SuperviseOptions& o) {
       }
       if (trial && markedGood(o)) {
         trial = false;  // passed: from here on it is the running firmware
-        device::crashPoint("supervise.marked-good");
       }
       if (trial && !stopping && !timedOut && nowS() - started > o.trialTimeoutS) {
         timedOut = true;
