@@ -1,6 +1,7 @@
 // stripemuxd: the scanner's firmware. Loads a board, opens its devices through the HAL this
 // build links, and serves range images to one host at a time until SIGTERM or SIGINT
-// (docs/firmware.md). Exit codes: 0 stopped cleanly, 1 usage, 2 rejected board, 3 device error.
+// (docs/firmware.md). Exit codes: 0 stopped cleanly, 1 usage, 2 rejected board, 3 device error,
+// 10 an update was installed (kExitUpdated; the supervisor starts it).
 #include <pthread.h>
 
 #include <CLI/CLI.hpp>
@@ -22,6 +23,8 @@
 #include "smx/net/tcp_client.hpp"
 #include "smx/net/tcp_link.hpp"
 #include "smx/protocol/secure_keys.hpp"
+#include "supervisor.hpp"
+#include "update_service.hpp"
 
 namespace {
 
@@ -40,6 +43,9 @@ struct Options {
   std::uint64_t frames = 0;
   double statusEveryS = 5;
   double idleTimeoutS = 30;  // DeviceOptions::idleTimeoutNs says why
+  bool supervise = false;
+  bool supervised = false;  // started by the supervisor: updates are taken
+  double trialTimeoutS = 30;
 };
 
 // SIGTERM and SIGINT are blocked in every thread and taken here, so the loops see a plain
@@ -146,8 +152,10 @@ int run(const Options& opts) {
     return secureLink ? smx::hal::Hal{devices.cameras, devices.trigger, *secureLink, devices.clock}
                       : devices;
   };
+  smx::firmware::UpdateService updates(opts.state, config.name, opts.supervised);
   smx::device::DeviceOptions base;
-  base.firmwareVersion = SMX_VERSION;
+  base.firmwareVersion = updates.runningVersion();
+  base.update = updates.hooks();
   base.idleTimeoutNs = static_cast<std::int64_t>(opts.idleTimeoutS * 1e9);
 
   const std::uint16_t tcpPort = (*hal)->hal().link.port();
@@ -198,9 +206,10 @@ int run(const Options& opts) {
       std::printf(
           "stripemuxd %s: board %s (%s HAL), %zu cameras %dx%d, %zu projectors, %zu KiB "
           "working memory\n",
-          SMX_VERSION, config.name.c_str(), std::string(smx::hal::halBackend()).c_str(),
-          rig.cameras.size(), rig.cameras.front().width, rig.cameras.front().height,
-          rig.projectors.size(), (*device)->arenaBytes() / 1024);
+          updates.runningVersion().c_str(), config.name.c_str(),
+          std::string(smx::hal::halBackend()).c_str(), rig.cameras.size(),
+          rig.cameras.front().width, rig.cameras.front().height, rig.projectors.size(),
+          (*device)->arenaBytes() / 1024);
       std::printf("listening on %s\n",
                   smx::net::toString({config.network.bindAddress, tcpPort}).c_str());
       if (!discovery) {
@@ -216,12 +225,25 @@ int run(const Options& opts) {
                     opts.open ? "--open" : "no --state");
       }
     }
+    if (updates.onTrial()) {
+      if (auto marked = updates.selfTestAndMarkGood(**device); !marked) {
+        std::fprintf(stderr, "stripemuxd: %s\n", marked.error().c_str());
+        stop = true;
+        return 3;
+      }
+      std::printf("slot %s: self-test passed, marked good\n", updates.runningSlot().c_str());
+    }
     std::printf("settings: %s\n", settings->describe().c_str());
     std::fflush(stdout);
     started = true;
     if (serve(**device, opts, rig.cameras.size(), stop)) {
       printCounters(**device, "stopped: ");
       break;
+    }
+    if ((*device)->updateDue()) {
+      printCounters(**device, "update installed, exiting for the supervisor: ");
+      stop = true;
+      return smx::firmware::kExitUpdated;
     }
     printCounters(**device, "restarting with new settings: ");
     for (smx::hal::Camera* camera : (*hal)->hal().cameras) {
@@ -263,10 +285,24 @@ int parseAndRun(int argc, char** argv) {
                  "seconds a host may send nothing (not streaming) or read nothing before it is "
                  "disconnected (default 30; 0: never)")
       ->check(CLI::Range(0.0, 86400.0));
+  app.add_flag("--supervise", opts.supervise,
+               "run as the supervisor: start the active slot's firmware (docs/update.md)");
+  app.add_option("--trial-timeout", opts.trialTimeoutS,
+                 "--supervise: seconds a new firmware has to pass its self-test (default 30)")
+      ->check(CLI::Range(1.0, 3600.0));
+  app.add_flag("--supervised", opts.supervised, "started by the supervisor")->group("");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;
+  }
+  if (opts.supervise) {
+    if (opts.state.empty()) {
+      std::fprintf(stderr, "stripemuxd: --supervise needs --state\n");
+      return 1;
+    }
+    return smx::firmware::supervise(
+        {opts.state, opts.board, opts.trialTimeoutS, smx::firmware::passedOn(argc, argv)});
   }
   return run(opts);
 }

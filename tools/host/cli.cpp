@@ -29,6 +29,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addBundleCommand(app, io, exitCode);
   addVerifyBundleCommand(app, io, exitCode);
   addPairCommand(app, io, exitCode);
+  addFlashCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -22,5 +22,6 @@ void addKeygenCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addPairCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

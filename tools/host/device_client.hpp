@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdint>
 #include <expected>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/stream_parser.hpp"
+#include "smx/protocol/update_messages.hpp"
 
 // The host tool's side of the protocol (docs/protocol.md): connect, hello → capabilities,
 // start/stop the stream, read range frames and statistics, capture raw frames. Errors are
@@ -45,6 +47,21 @@ struct DeviceEvent {
   protocol::Statistics statistics;  // kStatistics
 };
 
+// A firmware upload that did not end installed: refused by the device (error code 6: the bundle
+// is the problem), or the connection or the device failed.
+struct FlashFailure {
+  bool refused = false;
+  std::string message;
+};
+
+struct UpdateStatusReport {
+  protocol::UpdateOutcomeCode outcome = protocol::UpdateOutcomeCode::kNone;
+  std::string runningSlot;
+  std::string runningVersion;
+  std::string updateVersion;
+  std::string reason;
+};
+
 class DeviceClient {
  public:
   [[nodiscard]] static std::expected<DeviceClient, std::string> connect(
@@ -71,6 +88,15 @@ class DeviceClient {
       protocol::SetConfigMode mode, std::string_view json, std::chrono::milliseconds timeout);
   // The owner's encrypted channel (a device this host paired with), or the clear.
   [[nodiscard]] bool encrypted() const { return socket_.encrypted(); }
+  // Uploads a firmware bundle (device_client_update.cpp): `sent` is told the bytes sent so far,
+  // `step` each installation step the device reports. Ends when the device says it restarts.
+  [[nodiscard]] std::expected<void, FlashFailure> flash(
+      std::span<const std::byte> bundle,
+      const std::function<void(std::uint64_t sent, std::uint64_t total)>& sent,
+      const std::function<void(const protocol::FlashProgress&)>& step,
+      std::chrono::milliseconds timeout);
+  [[nodiscard]] std::expected<UpdateStatusReport, std::string> updateStatus(
+      std::chrono::milliseconds timeout);
   // Bad messages from the device so far (skipped).
   [[nodiscard]] std::uint64_t protocolErrors() const { return parser_->counters().errors; }
   void close() { socket_.close(); }
@@ -79,6 +105,8 @@ class DeviceClient {
   DeviceClient(DeviceSocket socket, std::string address);
   [[nodiscard]] std::expected<void, std::string> send(
       const protocol::ProtocolResult<std::span<const std::byte>>& message);
+  // A refusal (error) the device sent during an upload, without waiting; nullopt: none yet.
+  [[nodiscard]] std::optional<FlashFailure> flashRefusal();
   // The config message that answers a get-config or set-config.
   [[nodiscard]] std::expected<std::string, std::string> awaitConfig(
       std::chrono::milliseconds timeout, std::string_view request);

@@ -118,6 +118,12 @@ void Device::onMessage(const protocol::Message& message) {
     case MessageType::kSetConfig:
       onSetConfig(message);
       return;
+    case MessageType::kFlashBegin:
+    case MessageType::kFlashData:
+    case MessageType::kFlashEnd:
+    case MessageType::kGetUpdateStatus:
+      onFlash(message);
+      return;
     default:
       refuse(protocol::ErrorCode::kBadRequest, "that message type is not for the device");
       return;
@@ -254,6 +260,7 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
       hadClient_ = true;
       parser_.reset();
       helloSeen_ = false;
+      flashState_ = FlashState::kIdle;
       lastReceivedNs_ = lastSentNs_ = hal_.clock.nowNs();
       sentAtConnect_ = counters_.framesSent;
       droppedAtConnect_ = queue_.dropped();

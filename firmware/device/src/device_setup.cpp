@@ -13,6 +13,7 @@ using Fail = std::unexpected<std::string>;
 constexpr std::size_t kControlBytes = 4096;  // replies besides the capabilities
 // A set-config's settings, and the config message that answers it.
 constexpr std::size_t kConfigBytes = config::kDeviceConfigMaxBytes + 64;
+static_assert(kConfigBytes >= protocol::kFlashChunkBytes, "a flash-data chunk fits the parser");
 }  // namespace
 
 Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options)

@@ -9,10 +9,8 @@ namespace smx::protocol {
 
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
-  return (value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-          value <= static_cast<std::uint8_t>(MessageType::kSetConfig)) ||
-         (value >= static_cast<std::uint8_t>(MessageType::kSecureHello) &&
-          value <= static_cast<std::uint8_t>(MessageType::kPairReady));
+  return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
+         value <= static_cast<std::uint8_t>(MessageType::kPairReady);
 }
 
 const char* toString(MessageType type) {
@@ -45,6 +43,18 @@ const char* toString(MessageType type) {
       return "config";
     case MessageType::kSetConfig:
       return "set-config";
+    case MessageType::kFlashBegin:
+      return "flash-begin";
+    case MessageType::kFlashData:
+      return "flash-data";
+    case MessageType::kFlashEnd:
+      return "flash-end";
+    case MessageType::kFlashProgress:
+      return "flash-progress";
+    case MessageType::kGetUpdateStatus:
+      return "get-update-status";
+    case MessageType::kUpdateStatus:
+      return "update-status";
     case MessageType::kSecureHello:
       return "secure-hello";
     case MessageType::kSecureAccept:

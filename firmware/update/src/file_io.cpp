@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -60,32 +61,57 @@ std::expected<void, UpdateError> syncDirectory(const fs::path& dir) {
   return {};
 }
 
-std::expected<void, UpdateError> writeNewFile(const fs::path& path,
-                                              std::span<const std::byte> bytes, unsigned mode) {
+namespace {
+
+// writeNewFile() with a step hook: the atomic writer reports the steps between its calls.
+std::expected<void, UpdateError> writeNew(const fs::path& path, std::span<const std::byte> bytes,
+                                          unsigned mode, const StepHook& onStep) {
+  const auto step = [&](std::string_view name) {
+    if (onStep) {
+      onStep(name);
+    }
+  };
   Fd fd(::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600));
   if (fd.get() < 0) {
     return std::unexpected(ioError(path, "create"));
   }
+  step("temp-created");
   // fchmod, not the open mode: the umask must not decide a firmware file's mode.
-  if (::fchmod(fd.get(), mode) != 0 || !writeAll(fd.get(), bytes) || ::fsync(fd.get()) != 0) {
+  if (::fchmod(fd.get(), mode) != 0 || !writeAll(fd.get(), bytes)) {
     return std::unexpected(ioError(path, "write"));
   }
+  step("temp-written");
+  if (::fsync(fd.get()) != 0) {
+    return std::unexpected(ioError(path, "fsync"));
+  }
+  step("temp-synced");
   if (::close(fd.release()) != 0) {
     return std::unexpected(ioError(path, "close"));
   }
   return {};
 }
 
+}  // namespace
+
+std::expected<void, UpdateError> writeNewFile(const fs::path& path,
+                                              std::span<const std::byte> bytes, unsigned mode) {
+  return writeNew(path, bytes, mode, {});
+}
+
+fs::path tempPathOf(const fs::path& path) {
+  return path.string() + ".tmp";
+}
+
 std::expected<void, UpdateError> writeFileAtomic(const fs::path& path,
                                                  std::span<const std::byte> bytes, unsigned mode,
-                                                 Replace replace) {
+                                                 Replace replace, const StepHook& onStep) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   if (replace == Replace::kRefuse && ::access(path.c_str(), F_OK) == 0) {
     return std::unexpected(UpdateError{UpdateReason::kExists, path.string() + ": exists already"});
   }
-  const fs::path temp = path.string() + ".tmp." + std::to_string(::getpid());
+  const fs::path temp = tempPathOf(path);
   ::unlink(temp.c_str());
-  if (auto written = writeNewFile(temp, bytes, mode); !written) {
+  if (auto written = writeNew(temp, bytes, mode, onStep); !written) {
     ::unlink(temp.c_str());
     return written;
   }
@@ -105,7 +131,14 @@ std::expected<void, UpdateError> writeFileAtomic(const fs::path& path,
   if (replace == Replace::kRefuse) {
     ::unlink(temp.c_str());
   }
-  return syncDirectory(dir);
+  if (onStep) {
+    onStep("renamed");
+  }
+  auto synced = syncDirectory(dir);
+  if (synced && onStep) {
+    onStep("dir-synced");
+  }
+  return synced;
 }
 
 std::expected<std::vector<std::byte>, UpdateError> readFile(const fs::path& path,

@@ -16,12 +16,35 @@
 #include "smx/hal/board_hal.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/stream_parser.hpp"
+#include "smx/protocol/update_messages.hpp"
 
 // The appliance (docs/firmware.md): a capture loop that triggers the projectors, captures every
 // camera, runs the pipeline and queues range frames, and a network loop that serves one host
 // (hello → capabilities, start/stop stream, statistics, raw capture) and sends the queue. Each
 // loop runs on its own thread; after create() neither allocates.
 namespace smx::device {
+
+// The last firmware update as the device reports it (update-status).
+struct UpdateStatusInfo {
+  protocol::UpdateOutcomeCode outcome = protocol::UpdateOutcomeCode::kNone;
+  std::string runningSlot = "factory";
+  std::string runningVersion;
+  std::string updateVersion;
+  std::string reason;
+};
+
+// The firmware update (docs/update.md), implemented by the daemon so that this library holds no
+// update logic. Each runs on the network thread; unset, the flash messages are refused.
+struct UpdateHooks {
+  using Progress = std::function<void(protocol::FlashStep, std::string_view)>;
+  // flash-begin: checks the size against the limits and the free space, opens the upload file.
+  std::function<std::expected<void, std::string>(std::uint64_t size)> begin;
+  // flash-data: appends a chunk to the upload file.
+  std::function<std::expected<void, std::string>(std::span<const std::byte>)> data;
+  // flash-end: verifies and installs, telling each step; then the device exits (updateDue()).
+  std::function<std::expected<void, std::string>(const Progress&)> end;
+  std::function<UpdateStatusInfo()> status;
+};
 
 struct DeviceOptions {
   std::string firmwareVersion = "0.0.0";
@@ -41,6 +64,7 @@ struct DeviceOptions {
   // (or why not); the device then restarts with them (restartDue()). Runs on the network
   // thread; unset: set-config is refused.
   std::function<std::expected<std::string, std::string>(const protocol::SetConfig&)> setConfig;
+  UpdateHooks update;
 };
 
 // Counters, readable from any thread while the loops run.
@@ -91,6 +115,8 @@ class Device {
   // A set-config was stored and its answer sent: the owner of the loops stops them and creates
   // the device again with the new settings. runNetwork() returns when this turns true.
   [[nodiscard]] bool restartDue() const { return restartDue_; }
+  // With restartDue(): a firmware update was installed; the daemon exits for the supervisor.
+  [[nodiscard]] bool updateDue() const { return updateDue_; }
   // A host's capture-raw waits for the capture loop.
   [[nodiscard]] bool rawCaptureRequested() const { return rawState_ == RawState::kRequested; }
   [[nodiscard]] std::size_t arenaBytes() const;
@@ -112,6 +138,7 @@ class Device {
   std::size_t rawError(std::string_view what, const hal::HalError& error);
   void onMessage(const protocol::Message& message);
   void onSetConfig(const protocol::Message& message);
+  void onFlash(const protocol::Message& message);  // device_update.cpp
   void sendConfig(std::string_view json);
   void sendControl(std::span<const std::byte> message);
   void dropConnection();
@@ -135,6 +162,7 @@ class Device {
   std::atomic<protocol::Compression> compression_ = protocol::Compression::kRvl;
   std::atomic<bool> confidence_ = false;  // the host asked for the confidence planes
   std::atomic<bool> restartDue_ = false;
+  std::atomic<bool> updateDue_ = false;
 
   // Raw capture: the network thread takes a request (kIdle → kRequested), the capture loop
   // serves it (→ kCapturing → kReady), the network thread sends raw_ (→ kSending → kIdle).
@@ -156,6 +184,11 @@ class Device {
   std::size_t sent_ = 0;
   bool helloSeen_ = false;
   bool restartPending_ = false;  // a set-config was stored; its answer is on the way
+  // The upload of this host: flash-begin seen (kReceiving), or a chunk failed (kFailed).
+  enum class FlashState : std::uint8_t { kIdle, kReceiving, kFailed };
+  FlashState flashState_ = FlashState::kIdle;
+  std::uint64_t flashSize_ = 0;
+  std::uint64_t flashReceived_ = 0;
   bool hadClient_ = false;
   std::int64_t lastReceivedNs_ = 0;  // the host last sent bytes
   std::int64_t lastSentNs_ = 0;      // the socket last took bytes, or nothing was waiting

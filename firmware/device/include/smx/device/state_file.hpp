@@ -10,9 +10,8 @@
 // flushed to the disk, renamed over the file, and the directory entry is flushed too.
 namespace smx::device {
 
-// The steps of writeStateFile(), in order; `<what>.<step>` names a crash point.
-inline constexpr std::string_view kStateFileSteps[] = {"temp-created", "temp-written",
-                                                       "temp-synced", "renamed", "dir-synced"};
+// The steps of writeStateFile() are smx::update::kAtomicWriteSteps (its one atomic writer);
+// `<what>.<step>` names a crash point.
 
 // For the fault tests: when the environment variable SMX_CRASH_AT equals `point`, the process
 // kills itself with SIGKILL here, as a power cut would stop it.

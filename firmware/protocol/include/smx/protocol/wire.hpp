@@ -44,6 +44,13 @@ enum class MessageType : std::uint8_t {
   kGetConfig = 12,   // host → device: the settings the device runs with
   kConfig = 13,      // device → host: its settings (answer to get-config and set-config)
   kSetConfig = 14,   // host → device: change settings (stored, then the device restarts)
+  // The firmware update (update_messages.hpp).
+  kFlashBegin = 15,       // host → device: a firmware bundle of this size follows
+  kFlashData = 16,        // host → device: the bundle's next bytes
+  kFlashEnd = 17,         // host → device: the bundle is whole: verify and install it
+  kFlashProgress = 18,    // device → host: a step of the installation
+  kGetUpdateStatus = 19,  // host → device: the last update's outcome
+  kUpdateStatus = 20,     // device → host: its answer
   // The owner's channel (docs/security.md), sent in the clear before encryption starts.
   kSecureHello = 21,    // host → device: ephemeral and static key of a paired host
   kSecureAccept = 22,   // device → host: ephemeral and static key of the device

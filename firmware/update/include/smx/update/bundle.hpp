@@ -77,6 +77,10 @@ class VerifiedBundle {
     const std::filesystem::path& path, std::span<const PublicKey> trusted,
     const Expectations& expect);
 
+// The cheap check a sender makes before uploading: the size limits and both magics. Nothing is
+// verified.
+[[nodiscard]] std::expected<void, UpdateError> checkBundleShape(std::span<const std::byte> bytes);
+
 // Writes every file under slotDir, which must not exist: into slotDir.tmp (a stale one from an
 // interrupted extraction is removed first), each file and directory fsynced, then renamed to
 // slotDir and its parent fsynced. Nothing outside those two paths is touched.
