@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "payload.hpp"
 #include "smx/protocol/byte_io.hpp"
 #include "smx/protocol/rvl.hpp"
 
@@ -11,30 +12,8 @@ namespace {
 
 constexpr std::uint8_t kKnownCompressions = (1U << 0U) | (1U << 1U);
 
-// Runs `writePayload` on the payload area and seals the message.
-template <class WritePayload>
-ProtocolResult<std::span<const std::byte>> build(MessageType type, std::span<std::byte> out,
-                                                 WritePayload&& writePayload) {
-  if (out.size() < kHeaderBytes) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  ByteWriter payload(out.subspan(kHeaderBytes));
-  writePayload(payload);
-  if (!payload.ok()) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  return sealMessage(out, type, payload.size());
-}
-
-ProtocolResult<void> finished(const ByteReader& in) {
-  if (!in.ok()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload is shorter than its fields");
-  }
-  if (!in.atEnd()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload has bytes after its fields");
-  }
-  return {};
-}
+using detail::build;
+using detail::finished;
 
 bool validCompression(std::uint8_t value) {
   return value <= 1;

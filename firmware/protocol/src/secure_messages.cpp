@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "payload.hpp"
 #include "smx/protocol/byte_io.hpp"
 
 namespace smx::protocol {
@@ -11,35 +12,14 @@ namespace {
 constexpr std::uint8_t kMaxAttempts = 3;
 constexpr std::uint16_t kMaxSeconds = 3600;
 
-template <class WritePayload>
-ProtocolResult<std::span<const std::byte>> build(MessageType type, std::span<std::byte> out,
-                                                 WritePayload&& writePayload) {
-  if (out.size() < kHeaderBytes) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  ByteWriter payload(out.subspan(kHeaderBytes));
-  writePayload(payload);
-  if (!payload.ok()) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  return sealMessage(out, type, payload.size());
-}
+using detail::build;
+using detail::finished;
 
 Key32 getKey(ByteReader& in) {
   Key32 key{};
   const auto bytes = in.getBytes(kKeyBytes);
   std::copy(bytes.begin(), bytes.end(), key.begin());
   return key;
-}
-
-ProtocolResult<void> finished(const ByteReader& in) {
-  if (!in.ok()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload is shorter than its fields");
-  }
-  if (!in.atEnd()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload has bytes after its fields");
-  }
-  return {};
 }
 
 }  // namespace

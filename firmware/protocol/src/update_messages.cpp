@@ -1,31 +1,17 @@
 #include "smx/protocol/update_messages.hpp"
 
+#include "payload.hpp"
 #include "smx/protocol/byte_io.hpp"
 
 namespace smx::protocol {
 namespace {
 
-template <class WritePayload>
-ProtocolResult<std::span<const std::byte>> build(MessageType type, std::span<std::byte> out,
-                                                 WritePayload&& writePayload) {
-  if (out.size() < kHeaderBytes) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  ByteWriter payload(out.subspan(kHeaderBytes));
-  writePayload(payload);
-  if (!payload.ok()) {
-    return protocolFail(ProtocolErrc::kBufferTooSmall, "message does not fit its buffer");
-  }
-  return sealMessage(out, type, payload.size());
-}
+using detail::build;
 
 template <class T>
 ProtocolResult<T> finished(const ByteReader& in, const T& value) {
-  if (!in.ok()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload is shorter than its fields");
-  }
-  if (!in.atEnd()) {
-    return protocolFail(ProtocolErrc::kMalformed, "payload has bytes after its fields");
+  if (auto whole = detail::finished(in); !whole) {
+    return std::unexpected(whole.error());
   }
   return value;
 }

@@ -137,7 +137,7 @@ enum class ErrorCode : std::uint16_t {
   kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
   kBusy = 3,        // another host is connected
   kInternal = 4,
-  kNotPaired = 5,  // the device has an owner and this host is not one of its paired hosts
+  kNotPaired = 5,      // the device has an owner and this host is not one of its paired hosts
   kUpdateRefused = 6,  // a firmware bundle was refused (the text says why); nothing was installed
 };
 
