@@ -26,7 +26,7 @@ std::vector<std::byte> rangeFrame(Compression compression) {
     for (int x = 0; x < kWidth; ++x) {
       const bool hole = ((x / 16) + (y / 16)) % 10 == 0;
       depth[static_cast<std::size_t>(y * kWidth + x)] =
-          hole ? 0 : static_cast<std::uint16_t>(9000 + x + y / 2);
+          static_cast<std::uint16_t>(hole ? 0 : 9000 + x + y / 2);
     }
   }
   const auto plane = *algo::ConstDepthPlane::packed(depth, kWidth, kHeight);
