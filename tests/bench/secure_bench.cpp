@@ -36,21 +36,23 @@ std::vector<std::byte> rangeFrame(Compression compression) {
   return buffer;
 }
 
+// One connection's session: fresh ephemeral keys on both sides, keys derived, streams started.
+void startSession(SecureChannel& device, SecureChannel& host, const KeyPair& deviceId,
+                  const KeyPair& hostId) {
+  const KeyPair hostE = generateKeyPair();
+  const KeyPair deviceE = generateKeyPair();
+  device.start(
+      *deriveSessionKeys(Role::kDevice, deviceE, deviceId, {hostE.publicKey, hostId.publicKey}),
+      Role::kDevice);
+  host.start(
+      *deriveSessionKeys(Role::kHost, hostE, hostId, {deviceE.publicKey, deviceId.publicKey}),
+      Role::kHost);
+}
+
 struct Pair {
   SecureChannel device;
   SecureChannel host;
-  Pair() {
-    const KeyPair hostId = generateKeyPair();
-    const KeyPair deviceId = generateKeyPair();
-    const KeyPair hostE = generateKeyPair();
-    const KeyPair deviceE = generateKeyPair();
-    device.start(
-        *deriveSessionKeys(Role::kDevice, deviceE, deviceId, {hostE.publicKey, hostId.publicKey}),
-        Role::kDevice);
-    host.start(
-        *deriveSessionKeys(Role::kHost, hostE, hostId, {deviceE.publicKey, deviceId.publicKey}),
-        Role::kHost);
-  }
+  Pair() { startSession(device, host, generateKeyPair(), generateKeyPair()); }
 };
 
 // Moves what `from` has pending into `to` and reads its plaintext into `out`.
@@ -109,14 +111,7 @@ void BM_SessionHandshake(benchmark::State& state) {
   SecureChannel host;
   std::array<std::byte, 64> none{};
   for (auto _ : state) {
-    const KeyPair hostE = generateKeyPair();
-    const KeyPair deviceE = generateKeyPair();
-    device.start(
-        *deriveSessionKeys(Role::kDevice, deviceE, deviceId, {hostE.publicKey, hostId.publicKey}),
-        Role::kDevice);
-    host.start(
-        *deriveSessionKeys(Role::kHost, hostE, hostId, {deviceE.publicKey, deviceId.publicKey}),
-        Role::kHost);
+    startSession(device, host, deviceId, hostId);
     (void)transfer(device, host, none);
     (void)transfer(host, device, none);
     if (!host.confirmed() || !device.confirmed()) {

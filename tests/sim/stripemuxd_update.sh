@@ -161,19 +161,18 @@ config_intact good
 echo "good update: installed, running 0.2.0 in slot a"
 
 # 2. Failing firmware over the good one: rolled back to slot a with the reason.
-set +e
-"$tool" flash --device "$device" "$work/exits.smxb" >"$work/out" 2>"$work/err"; code=$?
-set -e
-[ "$code" -eq 4 ] || fail "exits: flash exit $code: $(cat "$work/err")"
-grep -q "rolled back 0.3.0: the firmware exited with code 1 before marking itself good; running 0.2.0 in slot a" \
-  "$work/err" || fail "exits: $(cat "$work/err")"
+rolled_back() {  # NAME WHY: flashing NAME.smxb ends in exit 4, rolled back to slot a for WHY
+  local code
+  set +e
+  "$tool" flash --device "$device" "$work/$1.smxb" >"$work/out" 2>"$work/err"; code=$?
+  set -e
+  [ "$code" -eq 4 ] || fail "$1: flash exit $code: $(cat "$work/err")"
+  grep -q "rolled back 0.3.0: $2; running 0.2.0 in slot a" "$work/err" ||
+    fail "$1: $(cat "$work/err")"
+}
+rolled_back exits "the firmware exited with code 1 before marking itself good"
 echo "firmware that exits: $(settled)"
-set +e
-"$tool" flash --device "$device" "$work/hangs.smxb" >"$work/out" 2>"$work/err"; code=$?
-set -e
-[ "$code" -eq 4 ] || fail "hangs: flash exit $code: $(cat "$work/err")"
-grep -q "rolled back 0.3.0: the firmware did not mark itself good within 10 s; running 0.2.0 in slot a" \
-  "$work/err" || fail "hangs: $(cat "$work/err")"
+rolled_back hangs "the firmware did not mark itself good within 10 s"
 echo "firmware that never marks good: $(settled)"
 config_intact rollback
 

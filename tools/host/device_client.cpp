@@ -181,9 +181,8 @@ std::expected<void, std::string> DeviceClient::requestStatistics() {
   return send(protocol::encodeEmpty(MessageType::kGetStatistics, out_));
 }
 
-std::expected<std::optional<std::pair<MessageType, std::vector<std::byte>>>, std::string>
-DeviceClient::nextMessage(std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
+DeviceClient::NextMessage DeviceClient::nextMessage(
+    std::chrono::steady_clock::time_point deadline) {
   while (true) {
     while (true) {
       const auto next = parser_->next();
@@ -325,9 +324,7 @@ std::expected<std::string, std::string> DeviceClient::awaitConfig(std::chrono::m
                                                                   std::string_view request) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    auto message = nextMessage(std::max(left, std::chrono::milliseconds(0)));
+    auto message = nextMessage(deadline);
     if (!message) {
       return Fail(message.error());
     }

@@ -110,10 +110,14 @@ class DeviceClient {
   // The config message that answers a get-config or set-config.
   [[nodiscard]] std::expected<std::string, std::string> awaitConfig(
       std::chrono::milliseconds timeout, std::string_view request);
-  // The next whole message (copied), or nullopt on timeout.
-  [[nodiscard]] std::expected<
-      std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>>, std::string>
-  nextMessage(std::chrono::milliseconds timeout);
+  // The next whole message (copied), or nullopt when none came by the deadline (or in timeout).
+  using NextMessage =
+      std::expected<std::optional<std::pair<protocol::MessageType, std::vector<std::byte>>>,
+                    std::string>;
+  [[nodiscard]] NextMessage nextMessage(std::chrono::steady_clock::time_point deadline);
+  [[nodiscard]] NextMessage nextMessage(std::chrono::milliseconds timeout) {
+    return nextMessage(std::chrono::steady_clock::now() + timeout);
+  }
 
   DeviceSocket socket_;
   std::unique_ptr<protocol::StreamParser> parser_;

@@ -64,9 +64,7 @@ std::expected<void, FlashFailure> DeviceClient::flash(
   }
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    auto next = nextMessage(std::max(left, std::chrono::milliseconds(0)));
+    auto next = nextMessage(deadline);
     if (!next) {
       return fail(next.error());
     }
@@ -100,9 +98,7 @@ std::expected<UpdateStatusReport, std::string> DeviceClient::updateStatus(
   }
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    auto next = nextMessage(std::max(left, std::chrono::milliseconds(0)));
+    auto next = nextMessage(deadline);
     if (!next) {
       return std::unexpected(next.error());
     }
