@@ -2,8 +2,9 @@
 //               [--lit all|none|ID,ID...] [--no-truth]
 // stripemux sim --rig rig.json --calibration N --out DIR [--seed S] [--target target.json]
 //               [--realism]
+// stripemux sim --rig rig.json --table-calibration N --out DIR [--seed S] [--target …] [--realism]
 // Renders what each camera of the rig sees, with ground truth, or calibration captures of a
-// checkerboard (docs/simulator.md, docs/cli.md).
+// checkerboard: free-standing, or leaning on a turntable (docs/simulator.md, docs/cli.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "commands.hpp"
 #include "output_files.hpp"
 #include "sim_calibration.hpp"
+#include "sim_table_calibration.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/config/scene_json.hpp"
 #include "smx/sim/named_scenes.hpp"
@@ -39,8 +41,9 @@ struct SimOptions {
   std::uint64_t seed = 1;
   std::string lit = "all";
   bool noTruth = false;
-  int calibration = 0;  // poses; 0: render the scene instead
-  fs::path target;      // empty: the default calib::Target
+  int calibration = 0;       // poses; 0: render the scene instead
+  int tableCalibration = 0;  // table angles; 0: none
+  fs::path target;           // empty: the default calib::Target
   bool realism = false;
 };
 
@@ -239,10 +242,12 @@ std::expected<void, std::string> writeCalibrationTruth(OutputFolder& top, Output
 std::expected<void, std::pair<int, std::string>> renderCalibrationPose(sim::Renderer& renderer,
                                                                        const algo::Rig& rig,
                                                                        int pose, std::uint64_t seed,
+                                                                       bool projectorsOffOnly,
                                                                        OutputFolder& folder) {
+  const std::size_t states = projectorsOffOnly ? 0 : rig.projectors.size();
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const auto& camera = rig.cameras[c];
-    for (std::size_t state = 0; state <= rig.projectors.size(); ++state) {
+    for (std::size_t state = 0; state <= states; ++state) {
       std::vector<bool> lit(rig.projectors.size(), false);
       std::string name;
       if (state > 0) {
@@ -283,7 +288,14 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
     }
     target = *loaded;
   }
-  const auto poses = drawTargetPoses(*rig, target, opts.calibration, opts.seed);
+  // A turntable's captures: the target leaning on the table at each angle, projectors off.
+  const bool table = opts.tableCalibration > 0;
+  const int count = table ? opts.tableCalibration : opts.calibration;
+  const TableLine line = defaultTableLine(*rig);
+  const std::vector<double> angles = tableAngles(opts.tableCalibration);
+  const auto poses = table ? std::expected<std::vector<TargetPose>, std::string>(
+                                 tableTargetPoses(target, line, angles))
+                           : drawTargetPoses(*rig, target, opts.calibration, opts.seed);
   if (!poses) {
     return fail(kExitBadInput, poses.error());
   }
@@ -299,8 +311,8 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
     return fail(kExitDeviceOrIo, top.error());
   }
   std::vector<fs::path> dirs = {opts.out / "truth"};
-  for (int pose = 0; pose < opts.calibration; ++pose) {
-    dirs.push_back(opts.out / poseDirName(pose));
+  for (int pose = 0; pose < count; ++pose) {
+    dirs.push_back(opts.out / (table ? tableViewName(pose) : poseDirName(pose)));
   }
   std::vector<OutputFolder> folders;  // truth, then one per pose
   for (const auto& dir : dirs) {
@@ -313,10 +325,18 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
   if (auto r = writeCalibrationTruth(*top, folders[0], *rig, target, *poses, scene); !r) {
     return fail(kExitDeviceOrIo, r.error());
   }
+  if (table) {
+    if (auto r = top->writeText("turntable.json", tableCapturesJson(angles)); !r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+    if (auto r = folders[0].writeText("axis.json", tableLineJson(line)); !r) {
+      return fail(kExitDeviceOrIo, r.error());
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
-  for (int pose = 0; pose < opts.calibration; ++pose) {
+  for (int pose = 0; pose < count; ++pose) {
     auto& folder = folders[static_cast<std::size_t>(pose) + 1];
-    if (auto r = renderCalibrationPose(**renderer, *rig, pose, opts.seed, folder); !r) {
+    if (auto r = renderCalibrationPose(**renderer, *rig, pose, opts.seed, table, folder); !r) {
       return fail(r.error().first, r.error().second);
     }
   }
@@ -330,10 +350,11 @@ int runCalibration(const SimOptions& opts, const CliStreams& io) {
       return fail(kExitDeviceOrIo, r.error());
     }
   }
-  io.out << "wrote " << opts.calibration << " calibration poses of a " << target.cols << "x"
-         << target.rows << " checkerboard to " << opts.out.string() << " ("
-         << rig->cameras.size() * (1 + rig->projectors.size()) << " images per pose, rendered in "
-         << std::lround(seconds) << " s; truth in " << (opts.out / "truth").string() << ")\n";
+  io.out << "wrote " << count << (table ? " turntable angles" : " calibration poses") << " of a "
+         << target.cols << "x" << target.rows << " checkerboard to " << opts.out.string() << " ("
+         << rig->cameras.size() * (1 + (table ? 0 : rig->projectors.size()))
+         << " images per pose, rendered in " << std::lround(seconds) << " s; truth in "
+         << (opts.out / "truth").string() << ")\n";
   return kExitOk;
 }
 
@@ -354,27 +375,40 @@ void addSimCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
                       "Render calibration captures of a checkerboard in N poses instead of a scene")
           ->check(CLI::Range(1, 99));
   scene->excludes(calibration);
+  auto* tableCalibration =
+      cmd->add_option("--table-calibration", opts->tableCalibration,
+                      "Render captures of a checkerboard leaning on a turntable at N angles "
+                      "(projectors off) for the table's axis")
+          ->check(CLI::Range(1, 99));
+  scene->excludes(tableCalibration);
+  calibration->excludes(tableCalibration);
   cmd->add_option("--target", opts->target,
                   "Calibration target (stripemux-target/1 JSON); default 9x6 corners, 25 mm")
-      ->needs(calibration);
+      ->excludes(scene);
   cmd->add_flag("--realism", opts->realism,
                 "Calibration captures with realistic optics drawn from their documented ranges")
-      ->needs(calibration);
+      ->excludes(scene);
   cmd->add_option("--out", opts->out, "Output directory")->required();
   cmd->add_option("--frames", opts->frames, "Number of frames (animated scenes move)")
       ->check(CLI::Range(1, 100000))
-      ->excludes(calibration);
+      ->excludes(calibration)
+      ->excludes(tableCalibration);
   cmd->add_option("--seed", opts->seed, "Noise seed");
   cmd->add_option("--lit", opts->lit, "Projectors on: all, none, or a comma-separated id list")
-      ->excludes(calibration);
-  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")->excludes(calibration);
+      ->excludes(calibration)
+      ->excludes(tableCalibration);
+  cmd->add_flag("--no-truth", opts->noTruth, "Write only the camera images")
+      ->excludes(calibration)
+      ->excludes(tableCalibration);
   cmd->callback([opts, &io, &exitCode] {
-    if (opts->calibration == 0 && opts->scene.empty()) {
-      io.err << "stripemux sim: give --scene, or --calibration N for calibration captures\n";
+    if (opts->calibration == 0 && opts->tableCalibration == 0 && opts->scene.empty()) {
+      io.err << "stripemux sim: give --scene, or --calibration N or --table-calibration N for "
+                "calibration captures\n";
       exitCode = kExitUsage;
       return;
     }
-    exitCode = opts->calibration > 0 ? runCalibration(*opts, io) : runSim(*opts, io);
+    exitCode = opts->calibration > 0 || opts->tableCalibration > 0 ? runCalibration(*opts, io)
+                                                                   : runSim(*opts, io);
   });
 }
 

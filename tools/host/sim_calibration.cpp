@@ -86,8 +86,8 @@ bool inImage(const algo::DeviceModel& device, const Vec3& world, double marginPx
          uv->y <= device.height - 1 - marginPx;
 }
 
-// The depth along the first camera's axis where that axis point lies deepest inside every
-// projector's image: where the rig's projectors and camera are aimed.
+}  // namespace
+
 double workingDistanceM(const algo::Rig& rig) {
   const auto& camera = rig.cameras.front();
   double best = 0.8;
@@ -108,6 +108,8 @@ double workingDistanceM(const algo::Rig& rig) {
   }
   return best;
 }
+
+namespace {
 
 // Image area covered by the sheet in `camera`, as a fraction of the image (unclipped).
 std::optional<double> sheetFill(const algo::DeviceModel& camera, const calib::Target& target,

@@ -33,6 +33,10 @@ inline constexpr std::uint8_t kPrintedBlack = 13;
 // Frames each pose is held in DIR/truth/scene.json, about a second at the device's frame rate.
 inline constexpr int kSceneHoldFrames = 30;
 
+// The depth along the first camera's axis where that axis point lies deepest inside every
+// projector's image: where the rig's projectors and camera are aimed.
+[[nodiscard]] double workingDistanceM(const algo::Rig& rig);
+
 // target.json text for `target`.
 [[nodiscard]] std::string targetJson(const calib::Target& target);
 
