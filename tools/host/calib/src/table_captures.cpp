@@ -7,12 +7,12 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
-#include "printf_text.hpp"
 #include "smx/calib/camera_calibration.hpp"
 #include "smx/config/field_reader.hpp"
 #include "smx/config/identifier.hpp"
 #include "smx/config/json_reader.hpp"
 #include "smx/sim/png_io.hpp"
+#include "smx/text/printf_text.hpp"
 
 namespace smx::calib {
 namespace {
@@ -35,8 +35,8 @@ std::string message(const config::FieldError& e) {
   return e.field.empty() ? e.problem : e.field + ": " + e.problem;
 }
 
-std::expected<std::vector<TableViewUse>, std::string> parseViews(std::string_view text) {
-  auto doc = config::parseDocument(text, kTableDocument);
+std::expected<std::vector<TableViewUse>, std::string> parseViews(std::string_view json) {
+  auto doc = config::parseDocument(json, kTableDocument);
   if (!doc) {
     return std::unexpected(message(doc.error()));
   }
@@ -44,9 +44,9 @@ std::expected<std::vector<TableViewUse>, std::string> parseViews(std::string_vie
   const nlohmann::json* views = r.find(*doc, "views");
   if (views == nullptr || !views->is_array() || views->empty() ||
       views->size() > static_cast<std::size_t>(kMaxTableViews)) {
-    return std::unexpected(
-        printfText("views: must be an array of 1 to %d views {\"id\": NAME, \"angle_deg\": A}",
-                   kMaxTableViews));
+    return std::unexpected(text::printfText(
+        "views: must be an array of 1 to %d views {\"id\": NAME, \"angle_deg\": A}",
+        kMaxTableViews));
   }
   std::vector<TableViewUse> out;
   for (std::size_t i = 0; i < views->size(); ++i) {
@@ -65,7 +65,7 @@ std::expected<std::vector<TableViewUse>, std::string> parseViews(std::string_vie
     use.angleDeg = std::nan("");
     r.number(v, at, "angle_deg", config::Range::kAny, use.angleDeg);
     if (r.ok() && !(std::abs(use.angleDeg) <= kMaxAngleDeg)) {
-      r.fail(at + ".angle_deg", printfText("required, within ±%.0f°", kMaxAngleDeg));
+      r.fail(at + ".angle_deg", text::printfText("required, within ±%.0f°", kMaxAngleDeg));
     }
     for (const auto& earlier : out) {
       if (r.ok() && earlier.id == use.id) {
@@ -173,7 +173,7 @@ std::expected<TableCalibration, std::string> calibrateTable(const algo::Rig& rig
 
 std::string tableReportText(const TableCalibration& calibration) {
   const AxisFit& a = calibration.axis;
-  std::string text = printfText(
+  std::string out = text::printfText(
       "turntable axis: direction (%.4f, %.4f, %.4f) through (%.4f, %.4f, %.4f) m\n"
       "  corners against the first view turned about it: RMS %.3f mm; rotations %.3f° RMS;"
       " angle scale %.4f\n",
@@ -182,13 +182,13 @@ std::string tableReportText(const TableCalibration& calibration) {
   std::size_t used = 0;
   for (const auto& view : calibration.views) {
     if (view.camera.empty()) {
-      text += "  " + view.id + ": " + view.note + "\n";
+      out += "  " + view.id + ": " + view.note + "\n";
     } else {
-      text += printfText("  %s at %.2f°: %s (%.3f mm)\n", view.id.c_str(), view.angleDeg,
-                         view.camera.c_str(), a.viewRmsM[used++] * 1000.0);
+      out += text::printfText("  %s at %.2f°: %s (%.3f mm)\n", view.id.c_str(), view.angleDeg,
+                              view.camera.c_str(), a.viewRmsM[used++] * 1000.0);
     }
   }
-  return text;
+  return out;
 }
 
 }  // namespace smx::calib

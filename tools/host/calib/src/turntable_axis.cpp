@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "printf_text.hpp"
+#include "smx/text/printf_text.hpp"
 
 namespace smx::calib {
 
@@ -37,16 +37,16 @@ std::vector<Eigen::Vector3d> worldCorners(const TableView& view,
 std::expected<AxisFit, std::string> fitTurntableAxis(std::span<const TableView> views,
                                                      const Target& target) {
   if (std::ssize(views) < kMinTableViews) {
-    return std::unexpected(printfText(
+    return std::unexpected(text::printfText(
         "the target was found at %zu table angles, at least %d are needed: capture more angles",
         views.size(), kMinTableViews));
   }
   const auto [lo, hi] = std::ranges::minmax(views, {}, &TableView::angleDeg);
   if (hi.angleDeg - lo.angleDeg < kMinTableSpanDeg) {
     return std::unexpected(
-        printfText("the table angles span %.1f°, at least %.0f° are needed: turn the table "
-                   "further between the first and the last view",
-                   hi.angleDeg - lo.angleDeg, kMinTableSpanDeg));
+        text::printfText("the table angles span %.1f°, at least %.0f° are needed: turn the table "
+                         "further between the first and the last view",
+                         hi.angleDeg - lo.angleDeg, kMinTableSpanDeg));
   }
 
   // Direction: every pair's relative rotation R_j·R_iᵀ is a turn by (θ_j − θ_i) about the axis,
@@ -97,7 +97,7 @@ std::expected<AxisFit, std::string> fitTurntableAxis(std::span<const TableView> 
     }
   }
   if (worstMedian > kSlipDeg) {
-    return std::unexpected(printfText(
+    return std::unexpected(text::printfText(
         "%s: the target is turned %.2f° off the table's axis against the other views (it slid "
         "or was moved, or the table's angle for it is wrong): keep it still on the table and "
         "capture again",

@@ -4,7 +4,7 @@
 #include <string>
 
 // printf-style text for messages (g++ 12 has no <format>).
-namespace smx::calib {
+namespace smx::text {
 
 template <class... Args>
 [[nodiscard]] std::string printfText(const char* format, Args... args) {
@@ -18,4 +18,4 @@ template <class... Args>
   return text;
 }
 
-}  // namespace smx::calib
+}  // namespace smx::text
