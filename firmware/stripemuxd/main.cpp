@@ -149,7 +149,8 @@ int run(const Options& opts) {
   }
   const auto deviceHal = [&] {
     const smx::hal::Hal devices = (*hal)->hal();
-    return secureLink ? smx::hal::Hal{devices.cameras, devices.trigger, *secureLink, devices.clock}
+    return secureLink ? smx::hal::Hal{devices.cameras, devices.trigger, *secureLink, devices.clock,
+                                      devices.turntable}
                       : devices;
   };
   smx::firmware::UpdateService updates(opts.state, config.name, opts.supervised);

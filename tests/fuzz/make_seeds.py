@@ -210,6 +210,13 @@ def range_seeds():
           b"\x87" + record(1, hello) + record(10, struct.pack("<I", 1)) +
           record(11, raw_band(0, 2)) + record(11, raw_band(2, 1)))
     write("protocol", "sealed_raw_band_past_height.bin", b"\x90" + record(11, raw_band(2, 2)[:-15]))
+    # get-turntable, turn-turntable by -90 degrees, the turntable's answer (docs/protocol.md).
+    turntable = struct.pack("<BIqqq", 1, 3200, -800, -90_000_000, 123_456_789)
+    write("protocol", "sealed_turntable.bin",
+          b"\x87" + record(1, hello) + record(29, b"") +
+          record(31, struct.pack("<Bq", 0, -90_000_000)) + record(30, turntable))
+    write("protocol", "sealed_turntable_bad_mode.bin",
+          b"\x90" + record(31, struct.pack("<Bq", 7, 1)) + record(30, turntable[:-1]))
 
 
 def config_seeds():

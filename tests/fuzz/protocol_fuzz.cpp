@@ -3,6 +3,7 @@
 // sanitizer report" it checks that the parser always makes progress and that a range frame that
 // decodes re-encodes to the same depth (and confidence), and a raw-frame band to the same bytes.
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -95,6 +96,31 @@ void checkRawFrame(const Message& message) {
   }
 }
 
+// A turntable state or turn request that decodes re-encodes to the very same payload.
+void checkTurntable(const Message& message) {
+  const auto state = decodeTurntable(message.payload);
+  if (!state) {
+    return;
+  }
+  std::array<std::byte, kHeaderBytes + kTurntablePayloadBytes> buffer{};
+  const auto again = encode(*state, buffer);
+  if (!again || !std::ranges::equal(again->subspan(kHeaderBytes), message.payload)) {
+    broken();
+  }
+}
+
+void checkTurnTurntable(const Message& message) {
+  const auto turn = decodeTurnTurntable(message.payload);
+  if (!turn) {
+    return;
+  }
+  std::array<std::byte, kHeaderBytes + 9> buffer{};
+  const auto again = encode(*turn, buffer);
+  if (!again || !std::ranges::equal(again->subspan(kHeaderBytes), message.payload)) {
+    broken();
+  }
+}
+
 void decodeAny(const Message& message) {
   switch (message.type) {
     case MessageType::kHello:
@@ -128,6 +154,12 @@ void decodeAny(const Message& message) {
     case MessageType::kSetConfig:
       (void)decodeSetConfig(message.payload);
       break;
+    case MessageType::kTurntable:
+      checkTurntable(message);
+      break;
+    case MessageType::kTurnTurntable:
+      checkTurnTurntable(message);
+      break;
     default:
       (void)decodeEmpty(message.payload);
       break;
@@ -140,7 +172,7 @@ void decodeAny(const Message& message) {
 std::vector<std::byte> framed(std::span<const std::byte> records) {
   std::vector<std::byte> stream;
   while (records.size() >= 3) {
-    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 15U);
+    const auto type = static_cast<MessageType>(std::to_integer<std::uint8_t>(records[0]) % 32U);
     const std::size_t length = std::min<std::size_t>(
         records.size() - 3,
         std::to_integer<std::size_t>(records[1]) | std::to_integer<std::size_t>(records[2]) << 8U);

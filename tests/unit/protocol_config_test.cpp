@@ -55,7 +55,7 @@ TEST(ConfigMessages, ConfigIsLengthPrefixedJson) {
   EXPECT_EQ(back->json, json);
   EXPECT_STREQ(toString(MessageType::kGetConfig), "get-config");
   EXPECT_TRUE(isKnown(MessageType::kSetConfig));
-  EXPECT_FALSE(isKnown(static_cast<MessageType>(29)));
+  EXPECT_FALSE(isKnown(static_cast<MessageType>(32)));
 }
 
 TEST(ConfigMessages, MalformedSetConfigIsRefused) {

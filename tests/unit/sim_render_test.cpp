@@ -291,9 +291,10 @@ std::optional<double> nearest(const std::vector<HitFn>& shapes, const Ray& r, do
 
 // Every pixel centre: truth depth = analytic depth rounded to float, NaN where nothing is hit.
 void expectDepthMatches(Renderer& renderer, const algo::Rig& rig, const std::vector<HitFn>& shapes,
-                        int frame = 0) {
+                        int frame = 0, double turntableDeg = 0.0) {
   auto req = request(rig);
   req.frame = frame;
+  req.turntableDeg = turntableDeg;
   const Frame f = renderFrame(renderer, rig, req);
   const auto& camera = rig.cameras[0];
   int hits = 0;
@@ -441,6 +442,44 @@ TEST(RenderDepth, MovingObjectsFollowTheirMotionPerFrame) {
     expectDepthMatches(*renderer, rig, {rectangle(o.pose, 0.4, 0.3)}, 0);
     expectDepthMatches(*renderer, rig, {rectangle(moved, 0.4, 0.3)}, 3);
   }
+}
+
+// The scene's turntable turns the objects standing on it, right-handed about its axis (up, -y)
+// through its pivot; the wall does not turn. Positions worked out by hand: seen from above, a
+// right-handed turn about "up" is counter-clockwise and takes +x towards +z.
+TEST(RenderDepth, TurntableObjectsTurnAboutTheAxisThroughThePivot) {
+  const algo::Rig rig = smallRig("rig_2proj_1cam.json", 4);
+  const Vec3 pivot{0.0, 0.0, 0.9};
+  Scene scene = quietScene();
+  scene.turntable = TurntableMount{.axis = {0.0, -2.0, 0.0}, .pivot = pivot};
+  Object ball0 = makeObject(Sphere{0.05}, Mat3::Identity(), pivot + Vec3{0.1, 0.0, 0.0});
+  ball0.onTurntable = true;
+  scene.objects.push_back(ball0);
+  scene.objects.push_back(makeObject(Plane{0.8, 0.5}, Mat3::Identity(), {0.0, 0.0, 1.2}));
+  const HitFn wall = rectangle(scene.objects[1].pose, 0.8, 0.5);
+  auto renderer = makeRenderer(rig, scene);
+  ASSERT_NE(renderer, nullptr);
+  expectDepthMatches(*renderer, rig, {ball(pivot + Vec3{0.1, 0.0, 0.0}, 0.05), wall}, 0, 0.0);
+  expectDepthMatches(*renderer, rig, {ball(pivot + Vec3{0.0, 0.0, 0.1}, 0.05), wall}, 0, 90.0);
+  expectDepthMatches(*renderer, rig, {ball(pivot + Vec3{0.0, 0.0, -0.1}, 0.05), wall}, 0, -90.0);
+  expectDepthMatches(*renderer, rig, {ball(pivot + Vec3{-0.1, 0.0, 0.0}, 0.05), wall}, 5, 180.0);
+
+  // A mesh (an Embree instance) turns its orientation too: 30 degrees, its centre from
+  // (-0.1, 0, 0) to (-0.1·cos 30°, 0, -0.1·sin 30°) off the pivot, its face turned with it.
+  Scene flat = quietScene();
+  flat.turntable = TurntableMount{.axis = {0.0, -1.0, 0.0}, .pivot = pivot};
+  Object card =
+      makeObject(rectangleMesh(0.15F, 0.15F), Mat3::Identity(), pivot + Vec3{-0.1, 0.0, 0.0});
+  card.onTurntable = true;
+  flat.objects.push_back(card);
+  auto cardRenderer = makeRenderer(rig, flat);
+  ASSERT_NE(cardRenderer, nullptr);
+  Pose turned;
+  turned.R = rotation(0.0, -30.0, 0.0);
+  turned.t = pivot + Vec3{-0.1 * std::cos(std::numbers::pi / 6), 0.0,
+                          -0.1 * std::sin(std::numbers::pi / 6)};
+  expectDepthMatches(*cardRenderer, rig, {rectangle(turned, 0.3, 0.3)}, 0, 30.0);
+  expectDepthMatches(*cardRenderer, rig, {rectangle(card.pose, 0.3, 0.3)}, 0, 0.0);
 }
 
 // ---- Projector ground truth ----

@@ -1141,3 +1141,51 @@ TEST(SceneValidation, InMemoryErrorsNameTheJsonField) {
 
 }  // namespace
 }  // namespace smx::sim
+
+namespace smx::sim {
+namespace {
+
+std::string turntableScene(std::string_view table, std::string_view onTable) {
+  return R"({"format": "stripemux-scene/1", )" + std::string(table) +
+         R"("objects": [{"shape": {"type": "sphere"}, "on_turntable": )" + std::string(onTable) +
+         "}]}";
+}
+
+TEST(SceneJson, TurntableAxisIsNormalisedAndItsObjectsNeedIt) {
+  const auto scene = config::parseScene(
+      turntableScene(R"("turntable": {"axis": [0, -3, 0], "pivot": [0, 0, 0.9]}, )", "true"), ".");
+  ASSERT_TRUE(scene.has_value()) << scene.error().message();
+  ASSERT_TRUE(scene->turntable.has_value());
+  EXPECT_EQ(scene->turntable->axis, Vec3(0, -1, 0));
+  EXPECT_EQ(scene->turntable->pivot, Vec3(0, 0, 0.9));
+  EXPECT_TRUE(scene->objects[0].onTurntable);
+
+  const auto still = config::parseScene(turntableScene("", "false"), ".");
+  ASSERT_TRUE(still.has_value());
+  EXPECT_FALSE(still->turntable.has_value());
+
+  const auto orphan = config::parseScene(turntableScene("", "true"), ".");
+  ASSERT_FALSE(orphan.has_value());
+  EXPECT_EQ(orphan.error().field, "objects[0].on_turntable");
+  const auto zero =
+      config::parseScene(turntableScene(R"("turntable": {"axis": [0, 0, 0]}, )", "true"), ".");
+  ASSERT_FALSE(zero.has_value());
+  EXPECT_EQ(zero.error().field, "turntable.axis");
+  const auto unknown = config::parseScene(
+      turntableScene(R"("turntable": {"axis": [0, 1, 0], "centre": [0, 0, 1]}, )", "true"), ".");
+  ASSERT_FALSE(unknown.has_value());
+  EXPECT_EQ(unknown.error().field, "turntable");
+  const auto notBool = config::parseScene(turntableScene("", "1"), ".");
+  ASSERT_FALSE(notBool.has_value());
+  EXPECT_EQ(notBool.error().field, "objects[0].on_turntable");
+
+  // A scene built in memory is held to the same rule.
+  Scene inMemory = *scene;
+  inMemory.turntable.reset();
+  const auto refused = config::validateScene(inMemory);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_EQ(refused.error().field, "objects[0].on_turntable");
+}
+
+}  // namespace
+}  // namespace smx::sim

@@ -62,6 +62,13 @@ struct UpdateStatusReport {
   std::string reason;
 };
 
+// A turntable request that did not end with the table's state: `absent` when the device has no
+// turntable (its board has none, or its firmware predates turntables), else why it failed.
+struct TurntableFailure {
+  bool absent = false;
+  std::string message;
+};
+
 class DeviceClient {
  public:
   [[nodiscard]] static std::expected<DeviceClient, std::string> connect(
@@ -86,6 +93,13 @@ class DeviceClient {
   // with, and restarts with them (this connection ends). A refusal names the setting.
   [[nodiscard]] std::expected<std::string, std::string> setConfig(
       protocol::SetConfigMode mode, std::string_view json, std::chrono::milliseconds timeout);
+  // The turntable's state (device_client_turntable.cpp); present is false on a board without one.
+  [[nodiscard]] std::expected<protocol::TurntableState, TurntableFailure> turntableStatus(
+      std::chrono::milliseconds timeout);
+  // Turns the table by (kRelative) or to (kAbsolute) `angleUdeg` and returns its state once it
+  // has settled: frames captured after `settledNs` (device clock) see the table still.
+  [[nodiscard]] std::expected<protocol::TurntableState, TurntableFailure> turnTurntable(
+      protocol::TurnMode mode, std::int64_t angleUdeg, std::chrono::milliseconds timeout);
   // The owner's encrypted channel (a device this host paired with), or the clear.
   [[nodiscard]] bool encrypted() const { return socket_.encrypted(); }
   // Uploads a firmware bundle (device_client_update.cpp): `sent` is told the bytes sent so far,
@@ -109,6 +123,9 @@ class DeviceClient {
   [[nodiscard]] std::optional<FlashFailure> flashRefusal();
   // The config message that answers a get-config or set-config.
   [[nodiscard]] std::expected<std::string, std::string> awaitConfig(
+      std::chrono::milliseconds timeout, std::string_view request);
+  // The turntable message that answers `request`.
+  [[nodiscard]] std::expected<protocol::TurntableState, TurntableFailure> awaitTurntable(
       std::chrono::milliseconds timeout, std::string_view request);
   // The next whole message (copied), or nullopt when none came by the deadline (or in timeout).
   using NextMessage =

@@ -164,6 +164,7 @@ std::size_t Device::captureRaw(std::uint32_t mask) {
 void Device::runCapture(const std::atomic<bool>& stop) {
   while (!stop) {
     (void)serveRawCapture();
+    (void)serveTurn();
     const auto captured = captureOnce();
     if (!captured && captured.error().code == hal::HalErrc::kDisconnected) {
       // Try to bring every camera back, then capture again; the host keeps its connection.

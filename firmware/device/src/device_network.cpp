@@ -118,6 +118,10 @@ void Device::onMessage(const protocol::Message& message) {
     case MessageType::kSetConfig:
       onSetConfig(message);
       return;
+    case MessageType::kGetTurntable:
+    case MessageType::kTurnTurntable:
+      onTurntable(message);
+      return;
     case MessageType::kFlashBegin:
     case MessageType::kFlashData:
     case MessageType::kFlashEnd:
@@ -186,6 +190,9 @@ void Device::dropConnection() {
     auto state = done;
     (void)rawState_.compare_exchange_strong(state, RawState::kIdle);
   }
+  // A move not started yet is not made; one under way ends, and answerTurn() drops its answer.
+  auto turn = TurnState::kRequested;
+  (void)turnState_.compare_exchange_strong(turn, TurnState::kIdle);
 }
 
 void Device::pumpSend(std::int64_t nowNs) {
@@ -270,7 +277,7 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     return;
   }
   const bool wantWrite = !sending_.empty() || controlSize_ > 0 || rawState_ == RawState::kReady ||
-                         (streaming_ && queue_.queued() > 0);
+                         turnState_ == TurnState::kDone || (streaming_ && queue_.queued() > 0);
   (void)link.waitForIo(wantWrite, timeoutNs);
 
   const std::int64_t now = hal_.clock.nowNs();
@@ -312,6 +319,7 @@ void Device::serviceNetwork(std::int64_t timeoutNs) {
     }
     onMessage(*message);
   }
+  answerTurn();
   pumpSend(now);
   if (restartPending_ && controlSize_ == 0 && sending_.empty()) {
     restartDue_ = true;  // the answer is out: the host knows the settings are stored
@@ -327,8 +335,10 @@ bool Device::idle(std::int64_t nowNs) const {
   if (timeout <= 0 || !hal_.link.connected()) {
     return false;
   }
-  // A streaming host need not send anything; every host must read what it is sent.
-  const bool silent = !streaming_ && nowNs - lastReceivedNs_ > timeout;
+  // A streaming host need not send anything, nor one waiting for the turntable to settle; every
+  // host must read what it is sent.
+  const bool silent =
+      !streaming_ && turnState_ == TurnState::kIdle && nowNs - lastReceivedNs_ > timeout;
   const bool stalled = nowNs - lastSentNs_ > timeout;
   return silent || stalled;
 }

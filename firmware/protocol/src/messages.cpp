@@ -195,6 +195,25 @@ ProtocolResult<std::span<const std::byte>> encode(const SetConfig& m, std::span<
   });
 }
 
+ProtocolResult<std::span<const std::byte>> encode(const TurntableState& m,
+                                                  std::span<std::byte> out) {
+  return build(MessageType::kTurntable, out, [&](ByteWriter& w) {
+    w.put(static_cast<std::uint8_t>(m.present ? 1 : 0));
+    w.put(m.stepsPerTurn);
+    w.put(static_cast<std::uint64_t>(m.position));
+    w.put(static_cast<std::uint64_t>(m.angleUdeg));
+    w.put(static_cast<std::uint64_t>(m.settledNs));
+  });
+}
+
+ProtocolResult<std::span<const std::byte>> encode(const TurnTurntable& m,
+                                                  std::span<std::byte> out) {
+  return build(MessageType::kTurnTurntable, out, [&](ByteWriter& w) {
+    w.put(static_cast<std::uint8_t>(m.mode));
+    w.put(static_cast<std::uint64_t>(m.angleUdeg));
+  });
+}
+
 ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
                                                           algo::ConstRgbView image,
                                                           std::span<std::byte> out) {
@@ -332,6 +351,41 @@ ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload) 
   CaptureRaw m{in.get<std::uint32_t>()};
   if (auto ok = finished(in); !ok) {
     return std::unexpected(ok.error());
+  }
+  return m;
+}
+
+ProtocolResult<TurntableState> decodeTurntable(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  const auto present = in.get<std::uint8_t>();
+  TurntableState m;
+  m.present = present == 1;
+  m.stepsPerTurn = in.get<std::uint32_t>();
+  m.position = static_cast<std::int64_t>(in.get<std::uint64_t>());
+  m.angleUdeg = static_cast<std::int64_t>(in.get<std::uint64_t>());
+  m.settledNs = static_cast<std::int64_t>(in.get<std::uint64_t>());
+  if (auto ok = finished(in); !ok) {
+    return std::unexpected(ok.error());
+  }
+  if (present > 1) {
+    return protocolFail(ProtocolErrc::kMalformed, "turntable: present is neither 0 nor 1");
+  }
+  if (m.present && m.stepsPerTurn == 0) {
+    return protocolFail(ProtocolErrc::kMalformed, "turntable: a turntable of 0 steps per turn");
+  }
+  return m;
+}
+
+ProtocolResult<TurnTurntable> decodeTurnTurntable(std::span<const std::byte> payload) {
+  ByteReader in(payload);
+  const auto mode = in.get<std::uint8_t>();
+  const TurnTurntable m{static_cast<TurnMode>(mode),
+                        static_cast<std::int64_t>(in.get<std::uint64_t>())};
+  if (auto ok = finished(in); !ok) {
+    return std::unexpected(ok.error());
+  }
+  if (mode > static_cast<std::uint8_t>(TurnMode::kAbsolute)) {
+    return protocolFail(ProtocolErrc::kMalformed, "turn-turntable: unknown mode");
   }
   return m;
 }

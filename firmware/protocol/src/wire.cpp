@@ -10,7 +10,7 @@ namespace smx::protocol {
 bool isKnown(MessageType type) {
   const auto value = static_cast<std::uint8_t>(type);
   return value >= static_cast<std::uint8_t>(MessageType::kHello) &&
-         value <= static_cast<std::uint8_t>(MessageType::kPairReady);
+         value <= static_cast<std::uint8_t>(MessageType::kTurnTurntable);
 }
 
 const char* toString(MessageType type) {
@@ -71,6 +71,12 @@ const char* toString(MessageType type) {
       return "pair-begin";
     case MessageType::kPairReady:
       return "pair-ready";
+    case MessageType::kGetTurntable:
+      return "get-turntable";
+    case MessageType::kTurntable:
+      return "turntable";
+    case MessageType::kTurnTurntable:
+      return "turn-turntable";
   }
   return "unknown";
 }

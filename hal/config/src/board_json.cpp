@@ -22,14 +22,17 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr std::array<std::string_view, 10> kTopKeys = {
-    "format",  "name",     "hal",     "rig", "depth_unit_m",
-    "cameras", "triggers", "network", "sim", "description"};
+constexpr std::array<std::string_view, 11> kTopKeys = {
+    "format",   "name",    "hal", "rig",         "depth_unit_m", "cameras",
+    "triggers", "network", "sim", "description", "turntable"};
 constexpr std::array<std::string_view, 5> kCameraKeys = {"id", "device", "pixel_format", "fps",
                                                          "buffers"};
 constexpr std::array<std::string_view, 2> kTriggerKeys = {"lead_us", "lines"};
 constexpr std::array<std::string_view, 4> kLineKeys = {"role", "chip", "line", "active_low"};
 constexpr std::array<std::string_view, 3> kNetworkKeys = {"bind", "port", "send_buffer_kib"};
+constexpr std::array<std::string_view, 8> kTurntableKeys = {
+    "chip",           "step",        "dir",      "enable", "enable_active_low",
+    "steps_per_turn", "speed_deg_s", "settle_ms"};
 constexpr std::array<std::string_view, 3> kSimKeys = {"scene", "replay", "seed"};
 constexpr std::array<std::string_view, 2> kHals = {"sim", "linux"};
 constexpr std::array<std::string_view, 3> kPixelFormats = {"RGB24", "BGR24", "YUYV"};
@@ -170,6 +173,62 @@ void readTriggers(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCo
   }
 }
 
+// A GPIO line of the turntable: required (`required`) or optional, on no trigger line of its chip.
+std::optional<unsigned> turntableLine(Reader& r, const Json& table, std::string_view key,
+                                      bool required, const hal::BoardConfig& board) {
+  const std::string at = member("turntable", key);
+  int offset = -1;
+  r.integer(table, "turntable", key, 0, 511, "the line offset on the chip", offset);
+  if (r.ok() && offset < 0) {
+    if (required) {
+      r.fail(at, "required field is missing; the line offset on the chip");
+    }
+    return std::nullopt;
+  }
+  const auto line = static_cast<unsigned>(offset);
+  for (const auto& trigger : board.trigger.lines) {
+    if (r.ok() && trigger.chip == board.turntable->chip && trigger.offset == line) {
+      r.fail(at, "line " + std::to_string(line) + " of " + trigger.chip +
+                     " is already the trigger line of " + jsonQuote(trigger.role));
+    }
+  }
+  return r.ok() ? std::optional<unsigned>(line) : std::nullopt;
+}
+
+void readTurntable(Reader& r, const Json& doc, hal::BoardConfig& board) {
+  const Json* table = r.find(doc, "turntable");
+  if (table == nullptr ||
+      !r.object(*table, "turntable", "the stepper turntable's lines and motion", kTurntableKeys)) {
+    return;
+  }
+  hal::TurntableConfig& t = board.turntable.emplace();
+  t.chip = r.text(*table, "turntable", "chip", "the GPIO chip, e.g. \"gpiochip0\"").value_or("");
+  t.stepLine = turntableLine(r, *table, "step", true, board).value_or(0);
+  t.dirLine = turntableLine(r, *table, "dir", true, board).value_or(0);
+  t.enableLine = turntableLine(r, *table, "enable", false, board);
+  if (r.ok() && t.dirLine == t.stepLine) {
+    r.fail("turntable.dir", "line " + std::to_string(t.dirLine) + " is already the STEP line");
+  }
+  if (r.ok() && t.enableLine && (*t.enableLine == t.stepLine || *t.enableLine == t.dirLine)) {
+    r.fail("turntable.enable", "line " + std::to_string(*t.enableLine) + " is already the " +
+                                   (*t.enableLine == t.stepLine ? "STEP" : "DIR") + " line");
+  }
+  r.boolean(*table, "turntable", "enable_active_low", t.enableActiveLow);
+  int stepsPerTurn = 0;
+  r.integer(*table, "turntable", "steps_per_turn", 1, 1'000'000, "steps of one full turn",
+            stepsPerTurn);
+  if (r.ok() && stepsPerTurn == 0) {
+    r.fail("turntable.steps_per_turn", "required field is missing; steps of one full turn");
+  }
+  t.stepsPerTurn = stepsPerTurn;
+  r.number(*table, "turntable", "speed_deg_s", Range::kPositive, t.speedDegS);
+  if (r.ok() && (t.speedDegS < 1.0 || t.speedDegS > 360.0)) {
+    r.fail("turntable.speed_deg_s",
+           "must be from 1 to 360 degrees per second, got " + formatNumber(t.speedDegS));
+  }
+  r.integer(*table, "turntable", "settle_ms", 0, 10'000, "milliseconds", t.settleMs);
+}
+
 void readNetwork(Reader& r, const Json& doc, hal::BoardConfig& board) {
   const Json* network = r.find(doc, "network");
   if (network == nullptr || !r.object(*network, "network", "the network", kNetworkKeys)) {
@@ -280,6 +339,7 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
   if (r.ok()) {
     readCameras(r, doc, out.rig, board);
     readTriggers(r, doc, out.rig, board);
+    readTurntable(r, doc, board);
     readNetwork(r, doc, board);
     readSim(r, doc, dir, board);
   }

@@ -51,7 +51,9 @@ constexpr double kMinStripePx = 1.0;
 constexpr std::size_t kMaxCameras = 16;
 constexpr std::string_view kKStructure = "K is [fx 0 cx; 0 fy cy; 0 0 1]";
 
-constexpr std::array<std::string_view, 3> kTopKeys = {"format", "cameras", "projectors"};
+constexpr std::array<std::string_view, 4> kTopKeys = {"format", "cameras", "projectors",
+                                                      "turntable"};
+constexpr std::array<std::string_view, 2> kTurntableKeys = {"axis", "point"};
 constexpr std::array<std::string_view, 7> kCameraKeys = {"id",   "width", "height", "K",
                                                          "dist", "R",     "t"};
 constexpr std::array<std::string_view, 8> kProjectorKeys = {"id",   "width", "height", "K",
@@ -382,6 +384,36 @@ std::vector<Device> readDevices(Reader& r, const Json& doc, const DeviceList& li
   return out;
 }
 
+void checkTurntable(Reader& r, const algo::TurntableAxis& t) {
+  checkFinite(r, t.axis, "turntable.axis");
+  checkFinite(r, t.point, "turntable.point");
+  checkWithin(r, t.point, kMaxTranslationM, "turntable.point", "a coordinate (metres)");
+  const double norm = std::hypot(t.axis[0], t.axis[1], t.axis[2]);
+  if (r.ok() && !(norm > 0 && std::isfinite(norm))) {
+    r.fail("turntable.axis", "must be a direction (not the zero vector), e.g. [0, -1, 0]");
+  }
+}
+
+// The optional turntable axis; its direction is normalised.
+void readTurntable(Reader& r, const Json& doc, algo::Rig& rig) {
+  const Json* v = r.find(doc, "turntable");
+  if (v == nullptr ||
+      !r.object(*v, "turntable", "the turntable's axis in the world frame", kTurntableKeys)) {
+    return;
+  }
+  algo::TurntableAxis t;
+  r.array(*v, "turntable", "axis", "x, y, z direction of the axis", t.axis);
+  r.array(*v, "turntable", "point", "x, y, z of a point on the axis, metres", t.point);
+  checkTurntable(r, t);
+  if (r.ok()) {
+    const double norm = std::hypot(t.axis[0], t.axis[1], t.axis[2]);
+    for (double& c : t.axis) {
+      c /= norm;
+    }
+    rig.turntable = t;
+  }
+}
+
 std::expected<algo::Rig, RigError> parseRigImpl(std::string_view text) {
   auto doc = parseDocument(text, kRigDocument);
   if (!doc) {
@@ -393,6 +425,7 @@ std::expected<algo::Rig, RigError> parseRigImpl(std::string_view text) {
   algo::Rig rig;
   rig.cameras = readDevices<algo::Camera>(r, *doc, kCameraList, ids);
   rig.projectors = readDevices<algo::Projector>(r, *doc, kProjectorList, ids);
+  readTurntable(r, *doc, rig);
   if (!r.ok()) {
     return r.error();
   }
@@ -477,6 +510,9 @@ std::expected<void, RigError> validateRig(const algo::Rig& rig) {
     for (std::size_t i = 0; i < rig.projectors.size() && r.ok(); ++i) {
       checkAnyDevice(r, rig.projectors[i], element("projectors", i), ids);
     }
+    if (r.ok() && rig.turntable) {
+      checkTurntable(r, *rig.turntable);
+    }
     if (!r.ok()) {
       return r.error();
     }
@@ -491,6 +527,10 @@ std::string toJson(const algo::Rig& rig) {
   writeDevices(out, "cameras", rig.cameras);
   out += ",\n";
   writeDevices(out, "projectors", rig.projectors);
+  if (rig.turntable) {
+    out += ",\n  \"turntable\": {\"axis\": " + jsonNumbers(rig.turntable->axis) +
+           ", \"point\": " + jsonNumbers(rig.turntable->point) + "}";
+  }
   out += "\n}\n";
   return out;
 }

@@ -52,8 +52,9 @@ using sim::Shape;
 using sim::Sphere;
 using sim::Vec3;
 
-constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
-                                                      "camera_response", "objects"};
+constexpr std::array<std::string_view, 6> kTopKeys = {
+    "format", "supersampling", "lighting", "camera_response", "objects", "turntable"};
+constexpr std::array<std::string_view, 2> kTurntableKeys = {"axis", "pivot"};
 constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
                                                            "projector_power",
                                                            "inverse_square",
@@ -64,8 +65,8 @@ constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
 constexpr std::array<std::string_view, 9> kCameraKeys = {
     "crosstalk",  "gain",  "noise_sigma", "defocus_sigma_px", "response_gamma",
     "vignetting", "bayer", "exposure",    "exposure_samples"};
-constexpr std::array<std::string_view, 6> kObjectKeys = {"name",   "shape",         "pose",
-                                                         "motion", "pose_sequence", "albedo"};
+constexpr std::array<std::string_view, 7> kObjectKeys = {
+    "name", "shape", "pose", "motion", "pose_sequence", "albedo", "on_turntable"};
 constexpr std::array<std::string_view, 4> kPoseKeys = {"t", "rotation_deg", "R", "scale"};
 constexpr std::array<std::string_view, 4> kMotionKeys = {"velocity_m_per_frame", "axis",
                                                          "angular_deg_per_frame", "pivot"};
@@ -422,6 +423,39 @@ void readMotion(Reader& r, const Json& obj, const std::string& objectPath, Motio
   r.vec3(*v, path, "axis", "x, y, z direction of the rotation axis", Range::kAny, out.axis);
   r.number(*v, path, "angular_deg_per_frame", Range::kAny, out.angularDegPerFrame);
   r.vec3(*v, path, "pivot", "x, y, z of a point on the axis, metres", Range::kAny, out.pivot);
+}
+
+void readTurntable(Reader& r, const Json& doc, Scene& scene) {
+  const Json* v = r.find(doc, "turntable");
+  if (v == nullptr ||
+      !r.object(*v, "turntable", "the turntable's axis and pivot in the world frame",
+                kTurntableKeys)) {
+    return;
+  }
+  sim::TurntableMount& mount = scene.turntable.emplace();
+  r.vec3(*v, "turntable", "axis", "x, y, z direction of the turntable's axis", Range::kAny,
+         mount.axis);
+  r.vec3(*v, "turntable", "pivot", "x, y, z of a point on the axis, metres", Range::kAny,
+         mount.pivot);
+}
+
+void checkTurntable(Reader& r, const Scene& scene) {
+  if (!scene.turntable) {
+    for (std::size_t i = 0; i < scene.objects.size() && r.ok(); ++i) {
+      if (scene.objects[i].onTurntable) {
+        r.fail(member(element("objects", i), "on_turntable"),
+               "the scene has no \"turntable\" for the object to stand on");
+      }
+    }
+    return;
+  }
+  r.checkEach(scene.turntable->axis, "turntable.axis", Range::kAny);
+  if (r.ok() && !(scene.turntable->axis.stableNorm() > 0)) {
+    r.fail("turntable.axis",
+           "must not be the zero vector; it is the direction of the axis, e.g. "
+           "[0, -1, 0] (up)");
+  }
+  r.checkEach(scene.turntable->pivot, "turntable.pivot", Range::kAny);
 }
 
 void readChecker(Reader& r, const Json& v, const std::string& path, CheckerTexture& out) {
@@ -805,6 +839,7 @@ void readObject(Reader& r, const Json& v, std::size_t index, NameRegistry& names
   if (r.ok()) {
     checkAlbedo(r, object.albedo, member(path, "albedo"));
   }
+  r.boolean(v, path, "on_turntable", object.onTurntable);
   files.load(r, path, object);
   checkLoaded(r, object, path);
   scene.objects.push_back(std::move(object));
@@ -845,7 +880,12 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   checkLighting(r, scene.lighting);
   readCameraResponse(r, doc, scene.camera);
   checkCameraResponse(r, scene.camera);
+  readTurntable(r, doc, scene);
   readObjects(r, doc, baseDir, scene);
+  checkTurntable(r, scene);
+  if (r.ok() && scene.turntable) {
+    scene.turntable->axis /= scene.turntable->axis.stableNorm();
+  }
   if (!r.ok()) {
     return r.error();
   }
@@ -879,6 +919,7 @@ std::expected<void, SceneError> validateScene(const Scene& scene) {
       checkObject(r, scene.objects[i], element("objects", i));
       checkLoaded(r, scene.objects[i], element("objects", i));
     }
+    checkTurntable(r, scene);
     if (!r.ok()) {
       return r.error();
     }

@@ -93,7 +93,7 @@ struct FramePose {
 bool moves(const Object& o) {
   const Motion& m = o.motion;
   return !m.velocityMPerFrame.isZero(0.0) || m.angularDegPerFrame != 0.0 ||
-         !o.poseSequence.poses.empty();
+         !o.poseSequence.poses.empty() || o.onTurntable;
 }
 
 // The pose a sequence holds at time f (frames): that of the nearest whole frame, so an exposure
@@ -121,6 +121,18 @@ FramePose poseAt(const Object& object, double f) {
           .toRotationMatrix();
   return {turn * object.pose.R,
           turn * (object.pose.t - m.pivot) + m.pivot + f * m.velocityMPerFrame, object.pose.scale};
+}
+
+// The pose `pose` of an object on the scene's turntable once the table has turned by `deg`:
+// right-handed about its axis through its pivot (scene.hpp, TurntableMount).
+FramePose onTurntable(const Scene& scene, const Object& object, double deg, const FramePose& pose) {
+  if (!object.onTurntable || !scene.turntable || deg == 0.0) {
+    return pose;
+  }
+  const TurntableMount& table = *scene.turntable;
+  const Mat3 turn =
+      Eigen::AngleAxisd(deg * std::numbers::pi / 180.0, table.axis.normalized()).toRotationMatrix();
+  return {turn * pose.R, turn * (pose.t - table.pivot) + table.pivot, pose.scale};
 }
 
 // Per object: its Embree geometry and, for analytic shapes, the surfaces the user-geometry
@@ -340,7 +352,8 @@ class EmbreeRenderer final : public Renderer {
   std::vector<ObjectState> objects_;  // index = geometry ID in world_
   SceneHandle world_;
   bool anyMotion_ = false;
-  double time_ = 0.0;  // the time (frames) world_ is committed for
+  double time_ = 0.0;          // the time (frames) world_ is committed for
+  double turntableDeg_ = 0.0;  // and the turntable angle
   std::optional<detail::BayerCell> bayer_;
   std::vector<Vec3> radiance_;  // per pixel: mean reflected light over samples and exposure
   std::vector<RgbF> linear_;
@@ -496,7 +509,7 @@ void EmbreeRenderer::setTime(double time) {
     if (!moves(*state.object)) {
       continue;
     }
-    state.pose = poseAt(*state.object, time);
+    state.pose = onTurntable(scene_, *state.object, turntableDeg_, poseAt(*state.object, time));
     if (state.meshScene) {
       setInstanceTransform(state.geometry.get(), state.pose);
     }
@@ -805,8 +818,11 @@ std::expected<void, std::string> EmbreeRenderer::check(const FrameRequest& reque
   }
   const auto unit = [](double v) { return v >= 0.0 && v <= 1.0; };
   if (!std::ranges::all_of(request.power, unit) || !(request.exposureScale > 0.0) ||
-      !(request.gain > 0.0) || !std::isfinite(request.exposureScale * request.gain)) {
-    return std::unexpected("projector power must be in [0, 1], exposure scale and gain positive");
+      !(request.gain > 0.0) || !std::isfinite(request.exposureScale * request.gain) ||
+      !std::isfinite(request.turntableDeg)) {
+    return std::unexpected(
+        "projector power must be in [0, 1], exposure scale and gain positive, the turntable angle "
+        "finite");
   }
   if (truth == nullptr) {
     return {};
@@ -887,6 +903,10 @@ std::expected<void, std::string> EmbreeRenderer::render(const FrameRequest& requ
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   radiance_.resize(pixels);
   linear_.resize(pixels);
+  if (request.turntableDeg != turntableDeg_) {
+    turntableDeg_ = request.turntableDeg;
+    time_ = NAN;  // every pose is committed again at the new angle
+  }
   const std::vector<double> times = exposureTimes(request.frame);
   ctx.timeWeight = 1.0 / static_cast<double>(times.size());
   for (std::size_t k = 0; k < times.size(); ++k) {

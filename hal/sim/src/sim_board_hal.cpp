@@ -6,6 +6,7 @@
 
 #include "sim_camera.hpp"
 #include "sim_trigger.hpp"
+#include "sim_turntable.hpp"
 #include "smx/config/scene_json.hpp"
 #include "smx/hal/board_hal.hpp"
 #include "smx/hal/steady_clock.hpp"
@@ -25,7 +26,11 @@ using Fail = std::unexpected<std::string>;
 class SimBoardHal final : public BoardHal, public sim::SimBoardControl {
  public:
   [[nodiscard]] Hal hal() override {
-    return Hal{.cameras = cameraPointers_, .trigger = *trigger_, .link = *link_, .clock = clock_};
+    return Hal{.cameras = cameraPointers_,
+               .trigger = *trigger_,
+               .link = *link_,
+               .clock = clock_,
+               .turntable = turntable_.get()};
   }
 
   void injectTimeouts(int camera, int count) override { at(camera).injectTimeouts(count); }
@@ -52,6 +57,7 @@ class SimBoardHal final : public BoardHal, public sim::SimBoardControl {
   std::unique_ptr<sim::Renderer> renderer_;
   std::vector<std::vector<sim::RgbImage>> replay_;  // per camera
   std::unique_ptr<sim::SimTrigger> trigger_;
+  std::unique_ptr<sim::SimTurntable> turntable_;
   std::vector<std::unique_ptr<sim::SimCamera>> cameras_;
   std::vector<Camera*> cameraPointers_;
   std::unique_ptr<net::TcpLink> link_;
@@ -117,12 +123,16 @@ std::expected<std::unique_ptr<SimBoardHal>, std::string> SimBoardHal::create(
   // Replayed images were taken at one power: only rendered light can be dimmed.
   out->trigger_ =
       std::make_unique<sim::SimTrigger>(std::move(roles), out->clock_, out->replay_.empty());
+  if (board.turntable) {
+    out->turntable_ = std::make_unique<sim::SimTurntable>(*board.turntable, out->clock_);
+  }
   for (std::size_t i = 0; i < board.cameras.size(); ++i) {
     const CameraConfig& config = board.cameras[i];
     const sim::SimCameraSource source{.renderer = out->renderer_.get(),
                                       .rigCamera = static_cast<int>(i),
                                       .seed = board.sim.seed,
-                                      .replay = out->replay_.empty() ? nullptr : &out->replay_[i]};
+                                      .replay = out->replay_.empty() ? nullptr : &out->replay_[i],
+                                      .turntable = out->turntable_.get()};
     out->cameras_.push_back(std::make_unique<sim::SimCamera>(
         config.id, source, *out->trigger_, out->clock_, config.format, config.buffers));
     out->cameraPointers_.push_back(out->cameras_.back().get());

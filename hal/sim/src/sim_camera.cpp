@@ -131,6 +131,7 @@ hal::HalResult<void> SimCamera::produce(int buffer) {
   request.power.assign(request.lit.size(), trigger_.power() / 100.0);
   request.exposureScale = static_cast<double>(exposureUs_) / kSimNominalExposureUs;
   request.gain = gain_;
+  request.turntableDeg = source_.turntable != nullptr ? source_.turntable->angleDeg() : 0.0;
   auto view = *algo::RgbView::packed(pixels, format_.width, format_.height);
   if (!source_.renderer->render(request, view, nullptr)) {
     return halFail(HalErrc::kIo, "the simulator could not render the frame");

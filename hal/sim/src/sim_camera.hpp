@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "sim_trigger.hpp"
+#include "sim_turntable.hpp"
 #include "smx/hal/camera.hpp"
 #include "smx/hal/clock.hpp"
 #include "smx/sim/png_io.hpp"
@@ -30,6 +31,7 @@ struct SimCameraSource {
   int rigCamera = 0;
   std::uint64_t seed = 1;
   const std::vector<RgbImage>* replay = nullptr;  // replay these in a loop
+  const SimTurntable* turntable = nullptr;        // the angle its objects are rendered at
 };
 
 class SimCamera final : public hal::Camera {

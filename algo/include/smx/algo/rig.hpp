@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,9 +44,17 @@ struct Projector : DeviceModel {
   StripePattern pattern;
 };
 
+// A turntable's axis of rotation in the world frame: a positive angle turns right-handed about
+// `axis` (a unit vector) through `point`.
+struct TurntableAxis {
+  std::array<double, 3> axis{};
+  std::array<double, 3> point{};
+};
+
 struct Rig {
   std::vector<Camera> cameras;
   std::vector<Projector> projectors;
+  std::optional<TurntableAxis> turntable{};  // calibrated, or given by the board's maker
 };
 
 }  // namespace smx::algo

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,19 @@ struct TriggerConfig {
   int powerPercent = 100;       // every projector's light, percent of full
 };
 
+// A stepper turntable driven through a STEP/DIR driver (docs/boards.md, "turntable"). The
+// simulated board ignores the chip and lines.
+struct TurntableConfig {
+  std::string chip;  // "gpiochip0" (linux)
+  unsigned stepLine = 0;
+  unsigned dirLine = 0;
+  std::optional<unsigned> enableLine{};  // none: the driver is always enabled
+  bool enableActiveLow = true;           // most stepper drivers enable on a low EN
+  std::int32_t stepsPerTurn = 0;
+  double speedDegS = 30.0;
+  int settleMs = 500;
+};
+
 struct NetworkConfig {
   std::string bindAddress = "0.0.0.0";
   std::uint16_t port = 5555;  // 0: any free port (tests)
@@ -57,6 +71,7 @@ struct BoardConfig {
   std::filesystem::path rigPath;
   std::vector<CameraConfig> cameras;  // in the rig's camera order
   TriggerConfig trigger;
+  std::optional<TurntableConfig> turntable{};  // none: the board has no turntable
   NetworkConfig network;
   double depthUnitM = 1e-4;
   SimBoardConfig sim;

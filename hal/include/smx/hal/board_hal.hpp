@@ -12,6 +12,7 @@
 #include "smx/hal/clock.hpp"
 #include "smx/hal/link.hpp"
 #include "smx/hal/trigger.hpp"
+#include "smx/hal/turntable.hpp"
 
 // What the firmware runs on: the board's devices as interfaces. Exactly one backend library
 // (smx_hal_sim or smx_hal_linux) defines createBoardHal() and halBackend(); CMake picks it.
@@ -22,6 +23,7 @@ struct Hal {
   TriggerLines& trigger;
   Link& link;
   Clock& clock;
+  Turntable* turntable = nullptr;  // nullptr: the board has none
 };
 
 class BoardHal {

@@ -78,6 +78,7 @@ struct DeviceCounters {
   std::atomic<std::uint64_t> connections = 0;      // hosts served so far
   std::atomic<std::uint64_t> idleDisconnects = 0;  // hosts dropped after the idle timeout
   std::atomic<std::uint64_t> rawCaptures = 0;      // raw captures served (capture-raw)
+  std::atomic<std::uint64_t> turns = 0;            // turntable moves done (turn-turntable)
   std::atomic<std::uint64_t> decodeTimeUsTotal = 0;
   std::atomic<std::uint32_t> decodeTimeUsLast = 0;
 };
@@ -98,7 +99,11 @@ class Device {
   // one frame per camera and leaves the bands (or an error) for the network loop to send.
   // Returns whether one was served. Allocation-free.
   bool serveRawCapture();
-  // Runs serveRawCapture() and captureOnce() until stop is set.
+  // Turns the turntable as a host asked, if a request waits: blocks for the move and its settle
+  // time, then leaves the answer for the network loop. Returns whether one was served.
+  // Allocation-free.
+  bool serveTurn();
+  // Runs serveRawCapture(), serveTurn() and captureOnce() until stop is set.
   void runCapture(const std::atomic<bool>& stop);
   // One round of the network loop: accept, receive and answer, send; waits at most timeoutNs.
   void serviceNetwork(std::int64_t timeoutNs);
@@ -119,6 +124,8 @@ class Device {
   [[nodiscard]] bool updateDue() const { return updateDue_; }
   // A host's capture-raw waits for the capture loop.
   [[nodiscard]] bool rawCaptureRequested() const { return rawState_ == RawState::kRequested; }
+  // A host's turn-turntable waits for the capture loop.
+  [[nodiscard]] bool turnRequested() const { return turnState_ == TurnState::kRequested; }
   [[nodiscard]] std::size_t arenaBytes() const;
   [[nodiscard]] const hal::Hal& hal() const { return hal_; }
 
@@ -139,6 +146,11 @@ class Device {
   void onMessage(const protocol::Message& message);
   void onSetConfig(const protocol::Message& message);
   void onFlash(const protocol::Message& message);  // device_update.cpp
+  // get-turntable and turn-turntable (device_turntable.cpp).
+  void onTurntable(const protocol::Message& message);
+  [[nodiscard]] protocol::TurntableState turntableState() const;
+  // Queues the answer of a finished move for the host that asked.
+  void answerTurn();
   void sendConfig(std::string_view json);
   void sendControl(std::span<const std::byte> message);
   void dropConnection();
@@ -172,6 +184,16 @@ class Device {
   std::atomic<std::uint64_t> rawConnection_ = 0;  // the host that asked (counters_.connections)
   std::vector<std::byte> raw_;                    // every camera's bands, allocated at create()
   std::size_t rawSize_ = 0;                       // written before kReady, read after
+
+  // Turntable: the network thread takes a request (kIdle → kRequested), the capture loop moves
+  // (→ kMoving → kDone), the network thread answers (→ kIdle).
+  enum class TurnState : std::uint8_t { kIdle, kRequested, kMoving, kDone };
+  std::atomic<TurnState> turnState_ = TurnState::kIdle;
+  std::atomic<std::int32_t> turnSteps_ = 0;
+  std::atomic<std::uint64_t> turnConnection_ = 0;  // the host that asked (counters_.connections)
+  hal::HalError turnError_{};                      // written before kDone, read after
+  bool turnFailed_ = false;                        // likewise
+  std::atomic<std::int64_t> settledNs_ = 0;        // device clock at the end of the last settle
 
   // Network thread only.
   protocol::StreamParser parser_;

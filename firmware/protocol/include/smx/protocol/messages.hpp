@@ -132,6 +132,27 @@ struct SetConfig {
   std::string_view json;  // may be empty with kReset
 };
 
+// The turntable's state (message kTurntable): the answer to get-turntable, and to turn-turntable
+// once the move and its settle time are over.
+struct TurntableState {
+  bool present = false;  // false: the board has none (the other fields are 0)
+  std::uint32_t stepsPerTurn = 0;
+  std::int64_t position = 0;   // signed steps since start-up
+  std::int64_t angleUdeg = 0;  // position · 360e6 / stepsPerTurn, rounded (micro-degrees)
+  std::int64_t settledNs = 0;  // device clock at the end of the last settle; 0: no move yet
+};
+inline constexpr std::size_t kTurntablePayloadBytes = 29;
+
+enum class TurnMode : std::uint8_t {
+  kRelative = 0,  // turn by the angle
+  kAbsolute = 1,  // turn to the angle (0: where the table stood at start-up)
+};
+
+struct TurnTurntable {
+  TurnMode mode = TurnMode::kRelative;
+  std::int64_t angleUdeg = 0;  // micro-degrees, right-handed about the rig's turntable axis
+};
+
 enum class ErrorCode : std::uint16_t {
   kUnsupportedVersion = 1,
   kBadRequest = 2,  // a malformed message or one not valid now (start before hello)
@@ -163,12 +184,16 @@ struct ErrorMessage {
                                                                 std::span<std::byte> out);
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const SetConfig& m,
                                                                 std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const TurntableState& m,
+                                                                std::span<std::byte> out);
+[[nodiscard]] ProtocolResult<std::span<const std::byte>> encode(const TurnTurntable& m,
+                                                                std::span<std::byte> out);
 // The band `header.firstRow`, `header.rows` of `image` as a raw-frame message; the header's
 // width and height are taken from the image. kMalformed for a band outside the image.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeRawFrame(RawFrameHeader header,
                                                                         algo::ConstRgbView image,
                                                                         std::span<std::byte> out);
-// A message without payload: stop-stream, get-statistics, get-config.
+// A message without payload: stop-stream, get-statistics, get-config, get-turntable.
 [[nodiscard]] ProtocolResult<std::span<const std::byte>> encodeEmpty(MessageType type,
                                                                      std::span<std::byte> out);
 // A range frame of `depth` (width × height from the plane). RVL falls back to kNone when the
@@ -196,6 +221,8 @@ struct ErrorMessage {
 [[nodiscard]] ProtocolResult<CaptureRaw> decodeCaptureRaw(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<ConfigMessage> decodeConfig(std::span<const std::byte> payload);
 [[nodiscard]] ProtocolResult<SetConfig> decodeSetConfig(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<TurntableState> decodeTurntable(std::span<const std::byte> payload);
+[[nodiscard]] ProtocolResult<TurnTurntable> decodeTurnTurntable(std::span<const std::byte> payload);
 // Checks the band against its own frame size (inside it, pixels = rows × width × 3); the
 // receiver checks the frame size against what the device announced.
 [[nodiscard]] ProtocolResult<RawFrameView> decodeRawFrame(std::span<const std::byte> payload);

@@ -60,6 +60,10 @@ enum class MessageType : std::uint8_t {
   kPairDone = 26,       // device → host: the host's key is stored
   kPairBegin = 27,      // host → device: open a pairing code (printed on the device's console)
   kPairReady = 28,      // device → host: a code is open, its attempts and seconds left
+  // The turntable (messages.hpp).
+  kGetTurntable = 29,   // host → device: the turntable's state
+  kTurntable = 30,      // device → host: its state (answer to get- and turn-turntable)
+  kTurnTurntable = 31,  // host → device: turn it, answered once it has settled
 };
 
 [[nodiscard]] bool isKnown(MessageType type);

@@ -40,6 +40,7 @@ struct FrameRequest {
   std::vector<double> power{};  // per rig projector, 0…1 of the scene's power; empty: all full
   double exposureScale = 1.0;   // exposure time over the scene's: scales the light collected
   double gain = 1.0;            // sensor gain: scales the signal and the read noise
+  double turntableDeg = 0.0;    // the scene's turntable objects turned by this (scene.hpp)
 };
 
 class Renderer {

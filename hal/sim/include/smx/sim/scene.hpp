@@ -35,6 +35,13 @@ struct Motion {
   Vec3 pivot = Vec3::Zero();
 };
 
+// The scene's turntable: objects standing on it turn with it by the board's turntable angle,
+// right-handed about `axis` (world direction, unit) through `pivot` (world point).
+struct TurntableMount {
+  Vec3 axis = -Vec3::UnitY();  // up in a level rig (y is down)
+  Vec3 pivot = Vec3::Zero();
+};
+
 // A target placed by hand: the object holds each pose for holdFrames frames, then jumps to the
 // next, and starts again after the last (frame f shows poses[(f / holdFrames) mod n]). Empty
 // poses: the object keeps `Object::pose`. An object with a sequence has no Motion.
@@ -101,6 +108,8 @@ struct Object {
   Motion motion;
   PoseSequence poseSequence;
   Albedo albedo;
+  // Turned with the scene's turntable, after its pose and motion (the scene must have one).
+  bool onTurntable = false;
 };
 
 struct Lighting {
@@ -150,6 +159,7 @@ inline constexpr int kMaxSceneSupersampling = 8;
 
 struct Scene {
   std::vector<Object> objects;
+  std::optional<TurntableMount> turntable{};
   Lighting lighting;
   CameraResponse camera;
   int supersampling = 2;  // n × n samples per camera pixel
