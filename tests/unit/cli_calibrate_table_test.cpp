@@ -110,5 +110,43 @@ TEST_F(TableCaptures, HostileOrShortListsAreRefusedNamingTheField) {
   fs::remove_all(bad);
 }
 
+TEST_F(TableCaptures, CalibrateWritesTheRigWithTheAxisAndNothingOnFailure) {
+  const fs::path out = captures().parent_path() / (captures().filename().string() + "_out");
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const fs::path rigFile = out / "rig.json";
+  const auto run = test::runCli({"calibrate", "--turntable", "--rig", kRig.string(), "--captures",
+                                 captures().string(), "--out", rigFile.string()});
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("turntable axis: direction"), std::string::npos) << run.out;
+  const auto rig = config::loadRig(rigFile);
+  ASSERT_TRUE(rig) << rig.error().message();
+  ASSERT_TRUE(rig->turntable);
+  std::ifstream in(captures() / "truth/axis.json");
+  const auto truth = nlohmann::json::parse(in);
+  const Eigen::Vector3d direction = vec(truth.at("direction")).normalized();
+  const Eigen::Vector3d written(rig->turntable->axis[0], rig->turntable->axis[1],
+                                rig->turntable->axis[2]);
+  EXPECT_GT(written.dot(direction), std::cos(0.2 * std::numbers::pi / 180.0));
+  const Eigen::Vector3d point(rig->turntable->point[0], rig->turntable->point[1],
+                              rig->turntable->point[2]);
+  EXPECT_LT((point - vec(truth.at("point"))).cross(direction).norm(), 0.002);
+
+  // Captures without a usable list: exit 2, the earlier rig.json untouched.
+  const std::string before = config::toJson(*rig);
+  const fs::path empty = out / "empty";
+  fs::create_directories(empty);
+  fs::copy_file(captures() / "target.json", empty / "target.json");
+  const auto bad = test::runCli({"calibrate", "--turntable", "--rig", kRig.string(), "--captures",
+                                 empty.string(), "--out", rigFile.string()});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("turntable.json"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("nothing written"), std::string::npos) << bad.err;
+  const auto after = config::loadRig(rigFile);
+  ASSERT_TRUE(after);
+  EXPECT_EQ(config::toJson(*after), before);
+  fs::remove_all(out);
+}
+
 }  // namespace
 }  // namespace smx::host

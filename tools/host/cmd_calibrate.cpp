@@ -1,5 +1,6 @@
 // stripemux calibrate --rig NOMINAL.json --captures DIR --out RIG.json [--report DIR]
 // stripemux calibrate --device HOST[:PORT] --poses N --out RIG.json [--captures DIR] [--report DIR]
+// stripemux calibrate --turntable --rig RIG.json --captures DIR --out RIG2.json
 // A rig's cameras and projectors from captures of a printed target (docs/calibration.md), taken
 // beforehand or, with --device, by the guided capture first. The rig file is written only when
 // the solve succeeds, and then whole or not at all.
@@ -16,6 +17,7 @@
 #include "output_folder.hpp"
 #include "smx/calib/calibrate.hpp"
 #include "smx/calib/report.hpp"
+#include "smx/calib/table_captures.hpp"
 #include "smx/config/rig_json.hpp"
 
 namespace smx::host {
@@ -33,6 +35,8 @@ struct CalibrateOptions {
   int poses = 12;
   std::string target;  // COLSxROWS inner corners
   double squareM = 0;
+  // The turntable's axis from captures of the target on the table, added to a calibrated rig.
+  bool turntable = false;
 };
 
 int fail(const CliStreams& io, int code, const std::string& message) {
@@ -98,6 +102,39 @@ int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
     return fail(io, kExitBadInput, nominal.error().message());
   }
   return solveAndWrite(*nominal, opts, io);
+}
+
+// --turntable: the rig with the table's axis; its cameras must be calibrated already.
+int runTableCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
+  const fs::path outFile = opts.out.filename();
+  if (const auto problem = fileNameProblem(outFile.string())) {
+    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  }
+  const std::string untouched = "; nothing written (" + opts.out.string() + ")";
+  auto rig = config::loadRig(opts.rig);
+  if (!rig) {
+    return fail(io, kExitBadInput, rig.error().message() + untouched);
+  }
+  auto table = calib::calibrateTable(*rig, opts.captures);
+  if (!table) {
+    return fail(io, kExitBadInput, table.error() + untouched);
+  }
+  const auto& axis = table->axis;
+  rig->turntable =
+      algo::TurntableAxis{.axis = {axis.direction.x(), axis.direction.y(), axis.direction.z()},
+                          .point = {axis.point.x(), axis.point.y(), axis.point.z()}};
+  auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");
+  if (!rigDir) {
+    return fail(io, kExitDeviceOrIo, rigDir.error());
+  }
+  if (auto ok = rigDir->writeText(outFile.string(), config::toJson(*rig)); !ok) {
+    return fail(io, kExitDeviceOrIo, ok.error());
+  }
+  if (auto ok = rigDir->commit(); !ok) {
+    return fail(io, kExitDeviceOrIo, ok.error());
+  }
+  io.out << calib::tableReportText(*table) << "wrote " << opts.out.string() << "\n";
+  return kExitOk;
 }
 
 // RIG.json → RIG.captures beside it.
@@ -178,8 +215,16 @@ void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--square", opts->squareM, "With --device: the checkerboard's square, metres")
       ->check(CLI::Range(1e-4, 1.0))
       ->needs(device);
+  cmd->add_flag("--turntable", opts->turntable,
+                "Find the turntable's axis from --captures of the target on the table (see "
+                "stripemux sim --table-calibration) and write --rig with it")
+      ->excludes(device);
   cmd->callback([opts, device, rig, captures, &io, &exitCode] {
-    if (device->count() > 0) {
+    if (opts->turntable) {
+      exitCode = rig->count() == 0 || captures->count() == 0
+                     ? fail(io, kExitUsage, "--turntable needs --rig (calibrated) and --captures")
+                     : runTableCalibrate(*opts, io);
+    } else if (device->count() > 0) {
       exitCode = runDeviceCalibrate(*opts, io);
     } else if (rig->count() == 0 || captures->count() == 0) {
       exitCode = fail(io, kExitUsage,
