@@ -9,9 +9,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <thread>
 #include <vector>
 
+#include "cli.hpp"
 #include "device_client.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/config/scene_json.hpp"
@@ -174,6 +176,18 @@ TEST(TurntableSim, TurningTheTableTurnsTheRangeImage) {
   ASSERT_TRUE(home.has_value()) << home.error().message;
   EXPECT_EQ(home->position, 0);
   EXPECT_GT(home->settledNs, turned->settledNs);
+  client->close();
+
+  // The command turns it too, by the rounded step: -45.1 deg is -400.89 steps, so -401.
+  std::ostringstream out;
+  std::ostringstream err;
+  EXPECT_EQ(host::runCli(std::vector<std::string>{"turntable", "--device", device.address(),
+                                                  "--turn", "-45.1"},
+                         {out, err}),
+            0)
+      << err.str();
+  EXPECT_NE(out.str().find("angle: -45.112500 deg"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("position: -401 steps"), std::string::npos) << out.str();
 }
 
 // Given a board without a turntable, get-turntable says none is there and a turn is refused with
@@ -189,6 +203,14 @@ TEST(TurntableSim, ABoardWithoutATableSaysSo) {
   ASSERT_FALSE(turn.has_value());
   EXPECT_TRUE(turn.error().absent);
   EXPECT_EQ(turn.error().message, "the device has no turntable");
+  client->close();
+
+  std::ostringstream out;
+  std::ostringstream err;
+  EXPECT_EQ(
+      host::runCli(std::vector<std::string>{"turntable", "--device", device.address()}, {out, err}),
+      2);
+  EXPECT_NE(err.str().find("the device has no turntable"), std::string::npos) << err.str();
 }
 
 }  // namespace
