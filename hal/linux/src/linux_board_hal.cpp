@@ -6,6 +6,7 @@
 #include "smx/hal/board_hal.hpp"
 #include "smx/hal/steady_clock.hpp"
 #include "smx/linux/gpiod_trigger.hpp"
+#include "smx/linux/gpiod_turntable.hpp"
 #include "smx/linux/libcamera_open.hpp"
 #include "smx/linux/v4l2_camera.hpp"
 #include "smx/linux/v4l2_io.hpp"
@@ -22,7 +23,11 @@ class LinuxBoardHal final : public BoardHal {
   LinuxBoardHal() = default;
 
   [[nodiscard]] Hal hal() override {
-    return Hal{.cameras = cameraPointers_, .trigger = *trigger_, .link = *link_, .clock = clock_};
+    return Hal{.cameras = cameraPointers_,
+               .trigger = *trigger_,
+               .link = *link_,
+               .clock = clock_,
+               .turntable = turntable_.get()};
   }
 
   lnx::SystemV4l2Io io_;  // declared first: the cameras use it until they are destroyed
@@ -30,6 +35,7 @@ class LinuxBoardHal final : public BoardHal {
   std::vector<std::unique_ptr<Camera>> libcameraCameras_;
   std::vector<Camera*> cameraPointers_;
   std::unique_ptr<lnx::GpiodTrigger> trigger_;
+  std::unique_ptr<lnx::GpiodTurntable> turntable_;
   std::unique_ptr<net::TcpLink> link_;
   SteadyClock clock_;
 };
@@ -116,6 +122,13 @@ std::expected<std::unique_ptr<BoardHal>, std::string> createBoardHal(const Board
     return std::unexpected(trigger.error());
   }
   result->trigger_ = std::move(*trigger);
+  if (board.turntable) {
+    auto turntable = lnx::GpiodTurntable::create(*board.turntable);
+    if (!turntable) {
+      return std::unexpected(turntable.error());
+    }
+    result->turntable_ = std::move(*turntable);
+  }
   auto link = net::TcpLink::create(board.network);
   if (!link) {
     return std::unexpected(link.error());
