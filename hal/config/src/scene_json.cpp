@@ -19,6 +19,7 @@
 #include <variant>
 #include <vector>
 
+#include "scene_handheld.hpp"
 #include "smx/config/field_reader.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_keys.hpp"
@@ -52,8 +53,8 @@ using sim::Shape;
 using sim::Sphere;
 using sim::Vec3;
 
-constexpr std::array<std::string_view, 5> kTopKeys = {"format", "supersampling", "lighting",
-                                                      "camera_response", "objects"};
+constexpr std::array<std::string_view, 6> kTopKeys = {
+    "format", "supersampling", "lighting", "camera_response", "objects", "handheld"};
 constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
                                                            "projector_power",
                                                            "inverse_square",
@@ -846,6 +847,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   readCameraResponse(r, doc, scene.camera);
   checkCameraResponse(r, scene.camera);
   readObjects(r, doc, baseDir, scene);
+  detail::readHandheld(r, doc, scene.handheld);
   if (!r.ok()) {
     return r.error();
   }
@@ -878,6 +880,9 @@ std::expected<void, SceneError> validateScene(const Scene& scene) {
     for (std::size_t i = 0; i < scene.objects.size() && r.ok(); ++i) {
       checkObject(r, scene.objects[i], element("objects", i));
       checkLoaded(r, scene.objects[i], element("objects", i));
+    }
+    if (scene.handheld && r.ok()) {
+      detail::checkHandheld(r, *scene.handheld);
     }
     if (!r.ok()) {
       return r.error();
