@@ -30,7 +30,7 @@ struct RangeView {
   std::string id;  // a name ("00000", …), never a path
   std::vector<CameraRange> cameras;
   double depthUnitM = 1e-4;
-  std::int64_t captureNs = 0;         // the device's clock, 0 when unknown
+  std::int64_t captureNs = 0;          // the device's clock, 0 when unknown
   std::optional<double> turntableDeg;  // the table's angle when captured (turntable scans)
 };
 

@@ -1,0 +1,70 @@
+#pragma once
+
+#include <expected>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "smx/algo/rig.hpp"
+#include "smx/scan/fusion.hpp"
+#include "smx/scan/points.hpp"
+#include "smx/scan/range_view.hpp"
+#include "smx/scan/registration.hpp"
+
+// Views → one model (docs/scanning.md "Fusing views"): place each view (given pose, turntable
+// angle about the axis, or sequential ICP), refine with ICP to its neighbours and a pose graph
+// that closes the loop, refuse views that do not overlap, fuse into a TSDF and mesh.
+namespace smx::scan {
+
+struct FuseOptions {
+  double voxelM = 0.001;              // TSDF voxel; truncation 4 voxels
+  bool watertight = false;            // mesh by Screened Poisson instead of the TSDF's surface
+  double holeMaxM = 0.005;            // with watertight: holes up to this are closed
+  std::optional<TurntableAxis> axis;  // places views with turntable angles
+  bool refine = false;                // refine poses given by the caller too
+  double minFitness = 0.3;            // a view registering below this is refused
+  double registrationVoxelM = 0.002;  // the clouds registration works on (finest ICP level)
+  std::function<void(std::string_view)> progress;  // one line per step, when set
+};
+
+struct ViewReport {
+  std::string id;
+  bool fused = false;
+  std::string reason;    // why not fused
+  double fitness = 0.0;  // of its registration (1 when placed as given)
+  double rmseM = 0.0;
+  Pose pose = Pose::Identity();
+};
+
+struct FuseReport {
+  std::string placement;  // "given", "turntable", "sequential"
+  std::vector<ViewReport> views;
+  std::size_t fusedViews = 0;
+  Eigen::Vector3d extentMin = Eigen::Vector3d::Zero();  // the model's bounding box, model frame
+  Eigen::Vector3d extentMax = Eigen::Vector3d::Zero();
+  double loopClosureM = 0.0;  // turntable: gap between the last view's pose chained to the first
+  double registrationS = 0.0;
+  double fusionS = 0.0;
+  double meshingS = 0.0;
+};
+
+struct FuseResult {
+  Cloud model;
+  Mesh mesh;
+  std::vector<Pose> poses;  // one per view (refused views: their last estimate)
+  FuseReport report;
+};
+
+struct FuseError {
+  std::string message;
+  FuseReport report;  // as far as it got
+};
+
+// `givenPoses` is empty or one per view. Fewer than 2 views fused is an error.
+[[nodiscard]] std::expected<FuseResult, FuseError> fuseViews(
+    const std::vector<RangeView>& views, const algo::Rig& rig,
+    const std::vector<std::optional<Pose>>& givenPoses, const FuseOptions& options = {});
+
+}  // namespace smx::scan
