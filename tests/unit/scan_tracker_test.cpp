@@ -171,7 +171,7 @@ TEST_F(HeadHandheld, RelocalisesAfterAJumpThroughTheKeyframes) {
   EXPECT_NE(r.state, TrackingState::kLost) << r.reason;
 }
 
-// Given 8 frames of the head_handheld scene as the device would see and decode them (both
+// Given 6 frames of the head_handheld scene as the device would see and decode them (both
 // projectors on, the scene's motion blur and camera noise, the firmware's camera pipeline),
 // then every frame tracks and the trajectory is within 1 mm and 0.2° RMS of the true one.
 TEST(HeadHandheldDecoded, TracksDecodedFrames) {
@@ -183,7 +183,7 @@ TEST(HeadHandheldDecoded, TracksDecodedFrames) {
   ASSERT_TRUE(tracker.has_value()) << tracker.error();
   double sumT = 0.0;
   double sumR = 0.0;
-  constexpr int kDecoded = 8;
+  constexpr int kDecoded = 6;
   for (int f = 0; f < kDecoded; ++f) {
     const eval::SimFrame frame = eval::renderSimFrame(rig, scene, {.frame = f, .seed = 7});
     const auto run = eval::runPipeline(frame, 0);
