@@ -19,28 +19,28 @@
 namespace smx::scan {
 
 struct FuseOptions {
-  double voxelM = 0.001;              // TSDF voxel; truncation 4 voxels
-  bool watertight = false;            // mesh by Screened Poisson instead of the TSDF's surface
-  double holeMaxM = 0.005;            // with watertight: holes up to this are closed
-  std::optional<TurntableAxis> axis;  // places views with turntable angles
-  bool refine = false;                // refine poses given by the caller too
-  double minFitness = 0.3;            // a view registering below this is refused
-  double registrationVoxelM = 0.002;  // the clouds registration works on (finest ICP level)
-  std::function<void(std::string_view)> progress;  // one line per step, when set
+  double voxelM = 0.001;                // TSDF voxel; truncation 4 voxels
+  bool watertight = false;              // mesh by Screened Poisson instead of the TSDF's surface
+  double holeMaxM = 0.005;              // with watertight: holes up to this are closed
+  std::optional<TurntableAxis> axis{};  // places views with turntable angles
+  bool refine = false;                  // refine poses given by the caller too
+  double minFitness = 0.3;              // a view registering below this is refused
+  double registrationVoxelM = 0.002;    // the clouds registration works on (finest ICP level)
+  std::function<void(std::string_view)> progress{};  // one line per step, when set
 };
 
 struct ViewReport {
-  std::string id;
+  std::string id{};
   bool fused = false;
-  std::string reason;    // why not fused
+  std::string reason{};  // why not fused
   double fitness = 0.0;  // of its registration (1 when placed as given)
   double rmseM = 0.0;
   Pose pose = Pose::Identity();
 };
 
 struct FuseReport {
-  std::string placement;  // "given", "turntable", "sequential"
-  std::vector<ViewReport> views;
+  std::string placement{};  // "given", "turntable", "sequential"
+  std::vector<ViewReport> views{};
   std::size_t fusedViews = 0;
   Eigen::Vector3d extentMin = Eigen::Vector3d::Zero();  // the model's bounding box, model frame
   Eigen::Vector3d extentMax = Eigen::Vector3d::Zero();
@@ -51,15 +51,15 @@ struct FuseReport {
 };
 
 struct FuseResult {
-  Cloud model;
-  Mesh mesh;
+  Cloud model{};
+  Mesh mesh{};
   std::vector<Pose> poses;  // one per view (refused views: their last estimate)
-  FuseReport report;
+  FuseReport report{};
 };
 
 struct FuseError {
-  std::string message;
-  FuseReport report;  // as far as it got
+  std::string message{};
+  FuseReport report{};  // as far as it got
 };
 
 // `givenPoses` is empty or one per view. Fewer than 2 views fused is an error.

@@ -15,10 +15,10 @@
 namespace smx::scan {
 
 struct Mesh {
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<Eigen::Vector3d> normals;  // per vertex, empty or as long as vertices
-  std::vector<Eigen::Vector3d> colours;  // per vertex RGB in [0, 1], empty or as long
-  std::vector<Eigen::Vector3i> triangles;
+  std::vector<Eigen::Vector3d> vertices{};
+  std::vector<Eigen::Vector3d> normals{};  // per vertex, empty or as long as vertices
+  std::vector<Eigen::Vector3d> colours{};  // per vertex RGB in [0, 1], empty or as long
+  std::vector<Eigen::Vector3i> triangles{};
 };
 
 struct FusionOptions {
@@ -53,7 +53,7 @@ class Tsdf {
  private:
   struct Impl;
   explicit Tsdf(std::unique_ptr<Impl> impl);
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Impl> impl_{};
 };
 
 }  // namespace smx::scan

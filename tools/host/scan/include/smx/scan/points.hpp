@@ -13,9 +13,9 @@ namespace smx::scan {
 // Points with, when known, unit normals and RGB colours in [0, 1] (each either empty or as long
 // as `points`).
 struct Cloud {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector3d> normals;
-  std::vector<Eigen::Vector3d> colours;
+  std::vector<Eigen::Vector3d> points{};
+  std::vector<Eigen::Vector3d> normals{};
+  std::vector<Eigen::Vector3d> colours{};
 
   [[nodiscard]] bool empty() const { return points.empty(); }
   [[nodiscard]] std::size_t size() const { return points.size(); }

@@ -21,11 +21,11 @@ inline constexpr std::string_view kViewsFormat = "stripemux-views/1";
 enum class ScanMode { kTurntable, kHandheld, kStream };
 
 struct ViewsFolder {
-  algo::Rig rig;
+  algo::Rig rig{};
   ScanMode mode = ScanMode::kStream;
-  std::vector<RangeView> views;            // in capture order
-  std::vector<std::optional<Pose>> poses;  // one per view; set where views.json gives one
-  std::optional<TurntableAxis> axis;       // rig.json "turntable", else views.json "turntable_axis"
+  std::vector<RangeView> views{};            // in capture order
+  std::vector<std::optional<Pose>> poses{};  // one per view; set where views.json gives one
+  std::optional<TurntableAxis> axis{};  // rig.json "turntable", else views.json "turntable_axis"
 };
 
 // Reads DIR: DIR/views/views.json when present, else a stream folder's <cam>_<n>.depth.png
@@ -36,10 +36,10 @@ struct ViewsFolder {
 
 // One entry of views.json.
 struct ViewEntry {
-  std::string id;  // a name: 1–64 of A-Z a-z 0-9 _ -
+  std::string id{};  // a name: 1–64 of A-Z a-z 0-9 _ -
   std::int64_t captureNs = 0;
-  std::optional<double> turntableDeg;
-  std::optional<Pose> pose;  // rig → model
+  std::optional<double> turntableDeg{};
+  std::optional<Pose> pose{};  // rig → model
 };
 
 // views.json's text (for the `scan` command, which writes the PNGs itself with

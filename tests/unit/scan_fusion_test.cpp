@@ -1,0 +1,179 @@
+#include <gtest/gtest.h>
+#include <open3d/geometry/KDTreeFlann.h>
+#include <open3d/geometry/PointCloud.h>
+
+#include <iostream>
+#include <random>
+
+#include "scan_truth_views.hpp"
+#include "smx/scan/fuse.hpp"
+#include "smx/scan/fusion.hpp"
+#include "smx/scan/watertight.hpp"
+
+namespace smx::scan {
+namespace {
+
+// Share of `truth` points with a point of `mesh` within `radiusM`.
+double coverage(const std::vector<Eigen::Vector3d>& truth,
+                const std::vector<Eigen::Vector3d>& vertices, double radiusM) {
+  open3d::geometry::PointCloud cloud;
+  cloud.points_ = vertices;
+  const open3d::geometry::KDTreeFlann tree(cloud);
+  std::vector<int> index;
+  std::vector<double> d2;
+  std::size_t covered = 0;
+  for (const auto& p : truth) {
+    covered += tree.SearchKNN(p, 1, index, d2) == 1 && d2[0] <= radiusM * radiusM ? 1U : 0U;
+  }
+  return truth.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(truth.size());
+}
+
+// A sphere off the table's axis, seen from 8 table angles.
+class ScanFusionSphere : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    rig_ = test::twoCameraRig();
+    const auto scene = test::sphereScene(kRadius, kCentre);
+    for (int i = 0; i < 8; ++i) {
+      views_.push_back(
+          test::renderView(rig_, scene, test::tableAxis(), 45.0 * i, "0000" + std::to_string(i)));
+      truth_.emplace_back(test::tableMotion(test::tableAxis(), -45.0 * i));
+    }
+  }
+  static inline const Eigen::Vector3d kCentre{0.03, 0.0, 0.88};
+  static constexpr double kRadius = 0.06;
+  static inline algo::Rig rig_;
+  static inline std::vector<RangeView> views_;
+  static inline std::vector<std::optional<Pose>> truth_;
+};
+
+// Given eight views of a sphere at their true poses, when fused into a 1-mm TSDF, then the mesh
+// lies on the sphere within half a voxel and covers what the views saw.
+TEST_F(ScanFusionSphere, FusedMeshLiesOnTheSphereAndCoversIt) {
+  auto result = fuseViews(views_, rig_, truth_, {.voxelM = 0.001});
+  ASSERT_TRUE(result.has_value()) << result.error().message;
+  EXPECT_EQ(result->report.fusedViews, 8U);
+  const auto& mesh = result->mesh;
+  ASSERT_GT(mesh.vertices.size(), 10000U);
+  std::vector<double> distance;
+  for (const auto& v : mesh.vertices) {
+    distance.push_back(std::abs((v - kCentre).norm() - kRadius));
+  }
+  std::ranges::sort(distance);
+  EXPECT_LT(distance[distance.size() / 2], 0.00025);
+  EXPECT_LT(distance[distance.size() * 99 / 100], 0.0005);
+
+  // Every surface point some view saw, in the model frame (view 0's rig frame).
+  std::vector<Eigen::Vector3d> seen;
+  for (std::size_t i = 0; i < views_.size(); ++i) {
+    for (std::size_t c = 0; c < rig_.cameras.size(); ++c) {
+      const auto points = cameraPoints(rig_.cameras[c], views_[i].cameras[c], test::kDepthUnitM);
+      for (std::size_t k = 0; k < points.size(); k += 11) {
+        seen.push_back(*truth_[i] * points.points[k]);
+      }
+    }
+  }
+  ASSERT_GT(seen.size(), 5000U);
+  EXPECT_GT(coverage(seen, mesh.vertices, 0.0015), 0.99);
+  EXPECT_GT(coverage(seen, result->model.points, 0.0015), 0.99);
+  EXPECT_EQ(result->model.normals.size(), result->model.size());
+}
+
+// Given the same views without their poses and without an axis, and one view that has nothing
+// to do with the others, when fused, then that view is refused with its reason.
+TEST_F(ScanFusionSphere, AViewThatDoesNotOverlapIsRefusedWithItsReason) {
+  std::vector<RangeView> views;
+  for (int i = 0; i < 3; ++i) {  // small steps: sequential ICP has no better start
+    views.push_back(test::renderView(rig_, test::sphereScene(kRadius, kCentre), test::tableAxis(),
+                                     3.0 * i, "step" + std::to_string(i)));
+    views.back().turntableDeg.reset();
+  }
+  views.push_back(test::renderView(rig_, test::sphereScene(0.02, {-0.15, 0.1, 0.7}),
+                                   test::tableAxis(), 0, "stray"));
+  views.back().turntableDeg.reset();
+  // Sequential ICP on a sphere off the axis: small steps of 45° still overlap.
+  auto result = fuseViews(views, rig_, {}, {.voxelM = 0.002, .minFitness = 0.3});
+  ASSERT_TRUE(result.has_value()) << result.error().message;
+  EXPECT_EQ(result->report.placement, "sequential");
+  const auto& stray = result->report.views.back();
+  EXPECT_FALSE(stray.fused);
+  EXPECT_NE(stray.reason.find("view stray does not overlap the others (fitness"), std::string::npos)
+      << stray.reason;
+}
+
+TEST_F(ScanFusionSphere, TooFewOverlappingViewsIsAnError) {
+  std::vector<RangeView> views = {views_[0]};
+  views.push_back(test::renderView(rig_, test::sphereScene(0.02, {-0.15, 0.1, 0.7}),
+                                   test::tableAxis(), 0, "stray"));
+  for (auto& v : views) {
+    v.turntableDeg.reset();
+  }
+  auto result = fuseViews(views, rig_, {});
+  ASSERT_FALSE(result.has_value());
+  EXPECT_NE(result.error().message.find("overlap"), std::string::npos) << result.error().message;
+}
+
+// Given 8 views of the bunny round the table and the table's true axis, when fused, then the
+// refined poses are the true ones and the loop closes.
+TEST(ScanTurntable, TrueAxisPlacesTheViewsAndClosesTheLoop) {
+  const auto rig = test::twoCameraRig();
+  const auto scene = test::bunnyScene();
+  std::vector<RangeView> views;
+  for (int i = 0; i < 8; ++i) {
+    views.push_back(
+        test::renderView(rig, scene, test::tableAxis(), 45.0 * i, std::to_string(10 + i)));
+  }
+  FuseOptions options{.voxelM = 0.002, .axis = test::tableAxis()};
+  auto result = fuseViews(views, rig, {}, options);
+  ASSERT_TRUE(result.has_value()) << result.error().message;
+  std::cout << "registration " << result->report.registrationS << " s, fusion "
+            << result->report.fusionS << " s, meshing " << result->report.meshingS << " s\n";
+  EXPECT_EQ(result->report.placement, "turntable");
+  EXPECT_EQ(result->report.fusedViews, 8U);
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const Pose error =
+        result->poses[i] *
+        test::tableMotion(test::tableAxis(), -45.0 * static_cast<double>(i)).inverse();
+    const Eigen::Vector3d at = test::tableAxis().point;
+    EXPECT_LT((error * at - at).norm(), 2e-4) << "view " << i;
+    EXPECT_LT(Eigen::AngleAxisd(error.linear()).angle() * 180 / std::numbers::pi, 0.1)
+        << "view " << i;
+  }
+  EXPECT_LT(result->report.loopClosureM, 2e-4);
+}
+
+// Given a sphere's points with a small hole (4 mm across) and a large one (20 mm), when meshed
+// watertight with holes up to 6 mm closed, then the small hole is closed and the large stays
+// open.
+TEST(ScanWatertight, ClosesHolesUpToTheSizeAndLeavesLargerOnesOpen) {
+  const double r = 0.05;
+  const Eigen::Vector3d small = Eigen::Vector3d(1, 0, 0);
+  const Eigen::Vector3d large = Eigen::Vector3d(-1, 0, 0);
+  std::mt19937 random(3);
+  std::normal_distribution<double> n(0, 1);
+  Cloud cloud;
+  while (cloud.size() < 20000) {
+    const Eigen::Vector3d d = Eigen::Vector3d(n(random), n(random), n(random)).normalized();
+    if ((d * r - small * r).norm() < 0.002 || (d * r - large * r).norm() < 0.010) {
+      continue;
+    }
+    cloud.points.push_back(d * r);
+    cloud.normals.push_back(d);
+  }
+  auto mesh = watertightMesh(cloud, {.voxelM = 0.002, .holeMaxM = 0.006});
+  ASSERT_TRUE(mesh.has_value()) << mesh.error();
+  double nearSmall = 1;
+  double nearLarge = 1;
+  double worst = 0;
+  for (const auto& v : mesh->vertices) {
+    nearSmall = std::min(nearSmall, (v - small * r).norm());
+    nearLarge = std::min(nearLarge, (v - large * r).norm());
+    worst = std::max(worst, std::abs(v.norm() - r));
+  }
+  EXPECT_LT(nearSmall, 0.001);  // closed
+  EXPECT_GT(nearLarge, 0.005);  // open: its middle is 10 mm from any point, over 3 mm
+  EXPECT_LT(worst, 0.001);
+}
+
+}  // namespace
+}  // namespace smx::scan
