@@ -53,6 +53,14 @@ TEST(BoardJson, TheShippedBoardsLoad) {
   EXPECT_EQ(rpi->config.trigger.lines[1].offset, 27U);
   EXPECT_EQ(rpi->config.network.bindAddress, "0.0.0.0");
 
+  // The hand-held board: 15 fps, one camera, two projectors, the hand-held head scene.
+  const auto handheld = loadBoard(kBoards / "sim-handheld");
+  ASSERT_TRUE(handheld.has_value()) << handheld.error().message();
+  ASSERT_EQ(handheld->config.cameras.size(), 1U);
+  EXPECT_EQ(handheld->config.cameras[0].format.fps, 15);
+  EXPECT_EQ(handheld->config.sim.scene, "head_handheld");
+  EXPECT_EQ(handheld->rig.projectors.size(), 2U);
+
   // The kernel tests' board shares the simulator's rig through a relative path.
   const auto qemu = loadBoard(kBoards / "qemu");
   ASSERT_TRUE(qemu.has_value()) << qemu.error().message();

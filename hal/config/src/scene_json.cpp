@@ -19,6 +19,7 @@
 #include <variant>
 #include <vector>
 
+#include "scene_handheld.hpp"
 #include "smx/config/field_reader.hpp"
 #include "smx/config/json_errors.hpp"
 #include "smx/config/json_keys.hpp"
@@ -52,8 +53,8 @@ using sim::Shape;
 using sim::Sphere;
 using sim::Vec3;
 
-constexpr std::array<std::string_view, 6> kTopKeys = {
-    "format", "supersampling", "lighting", "camera_response", "objects", "turntable"};
+constexpr std::array<std::string_view, 7> kTopKeys = {
+    "format", "supersampling", "lighting", "camera_response", "objects", "turntable", "handheld"};
 constexpr std::array<std::string_view, 2> kTurntableKeys = {"axis", "pivot"};
 constexpr std::array<std::string_view, 7> kLightingKeys = {"ambient",
                                                            "projector_power",
@@ -886,6 +887,7 @@ std::expected<Scene, SceneError> parseSceneImpl(std::string_view text, const fs:
   if (r.ok() && scene.turntable) {
     scene.turntable->axis /= scene.turntable->axis.stableNorm();
   }
+  detail::readHandheld(r, doc, scene.handheld);
   if (!r.ok()) {
     return r.error();
   }
@@ -920,6 +922,9 @@ std::expected<void, SceneError> validateScene(const Scene& scene) {
       checkLoaded(r, scene.objects[i], element("objects", i));
     }
     checkTurntable(r, scene);
+    if (scene.handheld && r.ok()) {
+      detail::checkHandheld(r, *scene.handheld);
+    }
     if (!r.ok()) {
       return r.error();
     }

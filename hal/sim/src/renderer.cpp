@@ -22,6 +22,7 @@
 
 #include "camera_response.hpp"
 #include "gaussian_blur.hpp"
+#include "handheld_view.hpp"
 #include "shape_geometry.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/pattern_image.hpp"
@@ -331,6 +332,7 @@ class EmbreeRenderer final : public Renderer {
   std::expected<void, std::string> check(const FrameRequest& request, algo::RgbView image,
                                          const GroundTruthViews* truth) const;
   void setTime(double time);
+  [[nodiscard]] FramePose framePose(const Object& object, double time) const;
   [[nodiscard]] std::vector<double> exposureTimes(int frame) const;
   const std::vector<RgbF>* sampleRays(const FrameContext& ctx, int cameraIndex);
   void shadeRow(const FrameContext& ctx, int y);
@@ -352,8 +354,9 @@ class EmbreeRenderer final : public Renderer {
   std::vector<ObjectState> objects_;  // index = geometry ID in world_
   SceneHandle world_;
   bool anyMotion_ = false;
-  double time_ = 0.0;          // the time (frames) world_ is committed for
-  double turntableDeg_ = 0.0;  // and the turntable angle
+  std::optional<detail::HandheldView> handheld_;  // the rig moves: the world is drawn around it
+  double time_ = 0.0;                             // the time (frames) world_ is committed for
+  double turntableDeg_ = 0.0;                     // and the turntable angle
   std::optional<detail::BayerCell> bayer_;
   std::vector<Vec3> radiance_;  // per pixel: mean reflected light over samples and exposure
   std::vector<RgbF> linear_;
@@ -369,6 +372,9 @@ std::expected<void, std::string> EmbreeRenderer::init() {
     return ok;
   }
   bayer_ = detail::bayerCell(scene_.camera.bayer);
+  if (scene_.handheld) {
+    handheld_.emplace(*scene_.handheld, scene_.objects);
+  }
   return initGeometry();
 }
 
@@ -435,6 +441,7 @@ std::expected<void, std::string> EmbreeRenderer::initGeometry() {
       },
       &embreeError_);
 
+  anyMotion_ = handheld_.has_value();
   for (const auto& o : scene_.objects) {
     anyMotion_ = anyMotion_ || moves(o);
   }
@@ -446,7 +453,7 @@ std::expected<void, std::string> EmbreeRenderer::initGeometry() {
   for (std::size_t i = 0; i < objects_.size(); ++i) {
     auto& state = objects_[i];
     state.object = &scene_.objects[i];
-    state.pose = poseAt(*state.object, 0);
+    state.pose = framePose(*state.object, 0);
     if (const auto* mesh = std::get_if<Mesh>(&state.object->shape)) {
       // Triangles in local coordinates, built once; per frame only the instance moves.
       state.meshScene.reset(rtcNewScene(device_.get()));
@@ -506,10 +513,10 @@ void EmbreeRenderer::setTime(double time) {
     return;
   }
   for (auto& state : objects_) {
-    if (!moves(*state.object)) {
+    if (!handheld_ && !moves(*state.object)) {
       continue;
     }
-    state.pose = onTurntable(scene_, *state.object, turntableDeg_, poseAt(*state.object, time));
+    state.pose = framePose(*state.object, time);
     if (state.meshScene) {
       setInstanceTransform(state.geometry.get(), state.pose);
     }
@@ -517,6 +524,17 @@ void EmbreeRenderer::setTime(double time) {
   }
   rtcCommitScene(world_.get());
   time_ = time;
+}
+
+// The object's pose at `time` in the rig's frame (the world's when the rig stands still), on the
+// turntable at its angle.
+FramePose EmbreeRenderer::framePose(const Object& object, double time) const {
+  FramePose world = onTurntable(scene_, object, turntableDeg_, poseAt(object, time));
+  if (!handheld_) {
+    return world;
+  }
+  const Pose p = handheld_->seenFromRig(object, {world.R, world.t, world.scale}, time);
+  return {p.R, p.t, p.scale};
 }
 
 // The frame's instant, or the stratum centres of [frame − e/2, frame + e/2] when something

@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "smx/sim/handheld.hpp"
+
 // What the simulated rig looks at: objects with shape, pose, motion and albedo, plus the light and
 // camera-response settings of the render (scene.json, docs/scene-format.md). World frame and
 // units as in rig.json: metres, x right, y down, z forward (the example rigs use cam0's frame).
@@ -163,6 +165,8 @@ struct Scene {
   Lighting lighting;
   CameraResponse camera;
   int supersampling = 2;  // n × n samples per camera pixel
+  // The rig moves as in a hand-held scan (handheld.hpp); none: the rig stands still.
+  std::optional<Handheld> handheld;
 };
 
 }  // namespace smx::sim
