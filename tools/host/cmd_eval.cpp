@@ -19,6 +19,7 @@
 #include "output_folder.hpp"
 #include "smx/eval/suite.hpp"
 #include "smx/health/health_eval.hpp"
+#include "smx/scan_eval/scan_markdown.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/scene.hpp"
 
@@ -119,12 +120,43 @@ int runCalibrationEval(const EvalOptions& o, const CliStreams& io) {
   return kExitOk;
 }
 
+// `--only scan`: scans of the simulator's scenes against their true surfaces,
+// DIR/scan-results.md (scan_eval).
+int runScanEval(const EvalOptions& o, const CliStreams& io) {
+  scan_eval::TurntableEvalOptions turntable;
+  turntable.seed = o.seed;
+  turntable.supersampling = o.supersampling;
+  turntable.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
+  try {
+    const auto result = scan_eval::runTurntableEval(turntable);
+    auto out = OutputFolder::create(o.out);
+    if (!out) {
+      io.err << "stripemux eval: " << out.error() << '\n';
+      return kExitDeviceOrIo;
+    }
+    if (auto ok = out->writeText("scan-results.md",
+                                 scan_eval::scanResultsMarkdown(result, commandLine(o)));
+        !ok || !out->commit()) {
+      io.err << "stripemux eval: cannot write " << (o.out / "scan-results.md").string() << '\n';
+      return kExitDeviceOrIo;
+    }
+  } catch (const std::exception& e) {
+    io.err << "stripemux eval: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  io.out << "wrote " << (o.out / "scan-results.md").string() << '\n';
+  return kExitOk;
+}
+
 int runEval(const EvalOptions& o, const CliStreams& io) {
   if (o.only.size() == 1 && o.only.front() == "health") {
     return runHealthEval(o, io);
   }
   if (o.only.size() == 1 && o.only.front() == "calibration") {
     return runCalibrationEval(o, io);
+  }
+  if (o.only.size() == 1 && o.only.front() == "scan") {
+    return runScanEval(o, io);
   }
   eval::SuiteOptions suite;
   suite.seed = o.seed;
@@ -143,8 +175,8 @@ int runEval(const EvalOptions& o, const CliStreams& io) {
       }
       if (!found) {
         io.err << "stripemux eval: unknown section '" << name
-               << "' (sections: scenes, flat, table2, baselines, sweeps, realism; or health or "
-                  "calibration "
+               << "' (sections: scenes, flat, table2, baselines, sweeps, realism; or health, "
+                  "calibration or scan "
                << "alone)\n";
         return kExitUsage;
       }
@@ -190,7 +222,8 @@ void addEvalCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option(
          "--only", options->only,
          "Sections to run: scenes, flat, table2, baselines, sweeps, realism (default all); "
-         "or health or calibration alone (writes health.md, calibration-results.md)")
+         "or health, calibration or scan alone (writes health.md, calibration-results.md, "
+         "scan-results.md)")
       ->delimiter(',');
   cmd->add_option("--scene", options->scenes,
                   "Only the suite's runs of these named scenes (repeatable)");

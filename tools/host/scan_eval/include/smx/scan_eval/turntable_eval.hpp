@@ -1,0 +1,41 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+// The turntable scan's figures (`stripemux eval --only scan`, docs/scan-results.md): a named scene
+// whose objects stand on a turntable, rendered at N table angles with realistic optics, decoded by
+// the firmware's pipeline, fused by the host's scan library, and the mesh compared with the true
+// surface. Host code; throws std::runtime_error naming the step that failed.
+namespace smx::scan_eval {
+
+struct TurntableEvalOptions {
+  std::string scene = "bunny_turntable";
+  std::string rigFile = "rig_2proj_1cam.json";  // boards/sim/<rigFile>
+  int views = 24;
+  double voxelM = 0.001;
+  int supersampling = 0;  // 0: the scene's own
+  std::uint64_t seed = 1;
+  std::function<void(const std::string&)> progress{};
+};
+
+struct TurntableEvalResult {
+  std::string scene;
+  std::string rigFile;
+  int views = 0;
+  int fusedViews = 0;
+  double meanMm = 0.0;  // fused mesh vertices to the true surface
+  double p95Mm = 0.0;
+  // Of the true surface the views can see (visible from a camera and lit by a projector in some
+  // view), the share within 1 mm of the fused mesh.
+  double coverage = 0.0;
+  double loopClosureMm = 0.0;
+  double fuseS = 0.0;    // registration, fusion and meshing after the last view
+  double decodeS = 0.0;  // rendering and decoding every view (not part of the scan's time)
+  std::size_t meshVertices = 0;
+};
+
+[[nodiscard]] TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options);
+
+}  // namespace smx::scan_eval

@@ -1,0 +1,277 @@
+#include "smx/scan_eval/turntable_eval.hpp"
+
+#include <open3d/Open3D.h>
+#include <open3d/t/geometry/RaycastingScene.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <variant>
+
+#include "smx/algo/lens.hpp"
+#include "smx/eval/frame_eval.hpp"
+#include "smx/eval/sim_frame.hpp"
+#include "smx/scan/fuse.hpp"
+#include "smx/text/printf_text.hpp"
+
+namespace smx::scan_eval {
+
+namespace {
+
+namespace lens = algo::lens;
+using Clock = std::chrono::steady_clock;
+using Vec3 = Eigen::Vector3d;
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+// A true surface point counts as seen when the rendered truth depth at its pixel is within this
+// of its own depth, and as covered when a fused vertex lies within kCoveredM.
+constexpr double kVisibleM = 0.002;
+constexpr double kCoveredM = 0.001;
+constexpr int kSurfaceSamples = 200000;
+
+double seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+const sim::TurntableMount& mountOf(const sim::Scene& scene) {
+  if (!scene.turntable) {
+    throw std::runtime_error("the scene has no turntable");
+  }
+  return *scene.turntable;
+}
+
+// The scene with its table turned by `deg`: objects on it are turned about the table's line.
+sim::Scene turned(const sim::Scene& scene, double deg) {
+  const auto& mount = mountOf(scene);
+  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+  sim::Scene out = scene;
+  for (auto& object : out.objects) {
+    if (object.onTurntable) {
+      object.pose.R = q * object.pose.R;
+      object.pose.t = q * (object.pose.t - mount.pivot) + mount.pivot;
+    }
+  }
+  return out;
+}
+
+// An object's surface in the world frame, as triangles.
+std::shared_ptr<open3d::geometry::TriangleMesh> surfaceOf(const sim::Object& object) {
+  using open3d::geometry::TriangleMesh;
+  std::shared_ptr<TriangleMesh> mesh;
+  if (const auto* m = std::get_if<sim::Mesh>(&object.shape)) {
+    mesh = std::make_shared<TriangleMesh>();
+    for (const auto& v : m->vertices) {
+      mesh->vertices_.push_back(v.cast<double>());
+    }
+    for (const auto& t : m->triangles) {
+      mesh->triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
+                                    static_cast<int>(t[2]));
+    }
+  } else if (const auto* c = std::get_if<sim::Cylinder>(&object.shape)) {
+    // Open3D's cylinder runs along z; the scene's along local y.
+    mesh = TriangleMesh::CreateCylinder(c->radiusM, c->heightM, 128, 4);
+    mesh->Rotate(Eigen::Matrix3d(Eigen::AngleAxisd(-std::numbers::pi / 2, Vec3::UnitX())),
+                 Vec3::Zero());
+  } else if (const auto* s = std::get_if<sim::Sphere>(&object.shape)) {
+    mesh = TriangleMesh::CreateSphere(s->radiusM, 64);
+  } else if (const auto* b = std::get_if<sim::Box>(&object.shape)) {
+    mesh = TriangleMesh::CreateBox(b->sizeM.x(), b->sizeM.y(), b->sizeM.z());
+    mesh->Translate(-0.5 * b->sizeM);
+  } else if (const auto* p = std::get_if<sim::Plane>(&object.shape)) {
+    mesh = std::make_shared<TriangleMesh>();
+    const double w = p->widthM / 2;
+    const double h = p->heightM / 2;
+    mesh->vertices_ = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
+    mesh->triangles_ = {{0, 1, 2}, {0, 2, 3}};
+  }
+  for (auto& v : mesh->vertices_) {
+    v = object.pose.R * (object.pose.scale * v) + object.pose.t;
+  }
+  return mesh;
+}
+
+// The objects standing on the table, at angle 0: the model's frame.
+open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene) {
+  open3d::geometry::TriangleMesh all;
+  for (const auto& object : scene.objects) {
+    if (object.onTurntable) {
+      all += *surfaceOf(object);
+    }
+  }
+  if (all.triangles_.empty()) {
+    throw std::runtime_error("no object stands on the scene's turntable");
+  }
+  return all;
+}
+
+scan::CameraRange decoded(const eval::SimFrame& frame, int camera) {
+  const auto run = eval::runPipeline(frame, camera);
+  const algo::ConstDepthPlane merged = run->pipeline->merged();
+  scan::CameraRange range;
+  range.width = merged.width();
+  range.height = merged.height();
+  range.depth.reserve(static_cast<std::size_t>(range.width) *
+                      static_cast<std::size_t>(range.height));
+  for (int y = 0; y < range.height; ++y) {
+    const auto row = merged.row(y);
+    range.depth.insert(range.depth.end(), row.begin(), row.end());
+  }
+  return range;
+}
+
+// Marks the samples (model frame) that camera `camera` sees lit in `frame`, rendered with the
+// table at `deg`.
+void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scene, double deg,
+                 const std::vector<Vec3>& samples, std::vector<char>& seen) {
+  const auto& mount = mountOf(scene);
+  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+  const auto& device = frame.rig.cameras.at(static_cast<std::size_t>(camera));
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (seen[i] != 0) {
+      continue;
+    }
+    const Vec3 w = q * (samples[i] - mount.pivot) + mount.pivot;
+    const lens::Point3 world{w.x(), w.y(), w.z()};
+    const auto uv = lens::project(device, world);
+    if (!uv) {
+      continue;
+    }
+    const int x = static_cast<int>(std::lround(uv->x));
+    const int y = static_cast<int>(std::lround(uv->y));
+    if (x < 0 || y < 0 || x >= device.width || y >= device.height) {
+      continue;
+    }
+    const double z = lens::toDevice(device, world)[2];
+    const double truth = frame.depth.at(x, y);
+    bool lit = false;
+    for (const auto& mask : frame.lit) {
+      lit = lit || mask.at(x, y) != 0;
+    }
+    if (lit && std::isfinite(truth) && std::abs(z - truth) < kVisibleM) {
+      seen[i] = 1;
+    }
+  }
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) {
+    return 0.0;
+  }
+  const auto k = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1));
+  std::ranges::nth_element(values, values.begin() + static_cast<std::ptrdiff_t>(k));
+  return values[k];
+}
+
+}  // namespace
+
+TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
+  const auto say = [&](const std::string& line) {
+    if (options.progress) {
+      options.progress(line);
+    }
+  };
+  sim::Scene scene = eval::loadNamedScene(options.scene);
+  if (options.supersampling > 0) {
+    scene.supersampling = options.supersampling;
+  }
+  algo::Rig rig = eval::loadExampleRig(options.rigFile);
+  const auto& mount = mountOf(scene);
+  rig.turntable = algo::TurntableAxis{.axis = {mount.axis.x(), mount.axis.y(), mount.axis.z()},
+                                      .point = {mount.pivot.x(), mount.pivot.y(), mount.pivot.z()}};
+
+  open3d::geometry::TriangleMesh truth = trueSurface(scene);
+  const auto sampled = truth.SamplePointsUniformly(kSurfaceSamples);
+  const std::vector<Vec3>& samples = sampled->points_;
+  std::vector<char> seen(samples.size(), 0);
+
+  TurntableEvalResult result;
+  result.scene = options.scene;
+  result.rigFile = options.rigFile;
+  result.views = options.views;
+  std::vector<scan::RangeView> views;
+  const auto decodeStart = Clock::now();
+  for (int k = 0; k < options.views; ++k) {
+    const double deg = 360.0 * k / options.views;
+    const sim::Scene at = turned(scene, deg);
+    scan::RangeView view;
+    view.id = text::printfText("%03d", k);
+    view.turntableDeg = deg;
+    view.depthUnitM = algo::kDefaultDepthUnitM;
+    for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c) {
+      eval::SimRequest request;
+      request.camera = c;
+      request.seed = options.seed + static_cast<std::uint64_t>(k);
+      const eval::SimFrame frame = eval::renderSimFrame(rig, at, request);
+      view.cameras.push_back(decoded(frame, c));
+      markVisible(frame, c, scene, deg, samples, seen);
+    }
+    views.push_back(std::move(view));
+    say(text::printfText("  view %d/%d at %.1f° rendered and decoded", k + 1, options.views, deg));
+  }
+  result.decodeS = seconds(decodeStart);
+
+  scan::FuseOptions fuse;
+  fuse.voxelM = options.voxelM;
+  fuse.axis = scan::TurntableAxis{.direction = mount.axis.normalized(), .point = mount.pivot};
+  const auto fuseStart = Clock::now();
+  auto fused = scan::fuseViews(views, rig, {}, fuse);
+  result.fuseS = seconds(fuseStart);
+  if (!fused) {
+    throw std::runtime_error("fusing the views: " + fused.error().message);
+  }
+  result.fusedViews = static_cast<int>(fused->report.fusedViews);
+  result.loopClosureMm = fused->report.loopClosureM * 1000.0;
+  const auto& vertices = fused->mesh.vertices;
+  result.meshVertices = vertices.size();
+  if (vertices.empty()) {
+    throw std::runtime_error("the fused mesh is empty");
+  }
+
+  // Vertices to the true surface.
+  open3d::t::geometry::RaycastingScene raycast;
+  raycast.AddTriangles(open3d::t::geometry::TriangleMesh::FromLegacy(truth));
+  std::vector<float> query;
+  query.reserve(vertices.size() * 3);
+  for (const auto& v : vertices) {
+    query.insert(query.end(),
+                 {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
+  }
+  const open3d::core::Tensor points(query, {static_cast<std::int64_t>(vertices.size()), 3},
+                                    open3d::core::Float32);
+  const auto distances = raycast.ComputeDistance(points);
+  const float* d = distances.GetDataPtr<float>();
+  std::vector<double> mm(d, d + vertices.size());
+  double sum = 0.0;
+  for (double& v : mm) {
+    v *= 1000.0;
+    sum += v;
+  }
+  result.meanMm = sum / static_cast<double>(mm.size());
+  result.p95Mm = percentile(mm, 0.95);
+
+  // The seen surface within reach of the mesh.
+  open3d::geometry::PointCloud meshPoints;
+  meshPoints.points_ = vertices;
+  const open3d::geometry::KDTreeFlann tree(meshPoints);
+  std::size_t visible = 0;
+  std::size_t covered = 0;
+  std::vector<int> index(1);
+  std::vector<double> distance2(1);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (seen[i] == 0) {
+      continue;
+    }
+    ++visible;
+    if (tree.SearchKNN(samples[i], 1, index, distance2) > 0 &&
+        distance2[0] <= kCoveredM * kCoveredM) {
+      ++covered;
+    }
+  }
+  result.coverage = visible > 0 ? static_cast<double>(covered) / static_cast<double>(visible) : 0;
+  return result;
+}
+
+}  // namespace smx::scan_eval
