@@ -30,6 +30,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addVerifyBundleCommand(app, io, exitCode);
   addPairCommand(app, io, exitCode);
   addFlashCommand(app, io, exitCode);
+  addFuseCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

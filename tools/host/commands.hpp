@@ -23,5 +23,6 @@ void addBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addPairCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addFuseCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host
