@@ -158,6 +158,16 @@ TEST_F(ScanViewsFolder, FuseWritesTheModelOrNothing) {
   EXPECT_EQ(fs::file_size(out / "mesh.stl"),
             84 + 50 * report["mesh"]["triangles"].get<std::size_t>());
 
+  // The same views without the axis in the folder: --axis gives it.
+  const auto noAxis = dir_ / "no_axis";
+  writeFolder(noAxis, rig_, views_, entriesOf(views_));
+  run = ::smx::test::runCli(
+      {"fuse", noAxis.string(), "--voxel", "2", "--axis", "0,-1,0", "--axis-point", "0,0,0.9"});
+  ASSERT_EQ(run.code, 0) << run.out << run.err;
+  std::ifstream again(noAxis / "report.json");
+  EXPECT_EQ(nlohmann::json::parse(again)["placement"], "turntable");
+  EXPECT_EQ(::smx::test::runCli({"fuse", noAxis.string(), "--axis", "0,-1,0"}).code, 1);
+
   // Two views of different spheres far apart, no poses, no axis.
   const auto bad = dir_ / "bad";
   auto stray = test::renderView(rig_, test::sphereScene(0.02, {-0.15, 0.1, 0.7}), test::tableAxis(),
