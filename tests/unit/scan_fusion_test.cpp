@@ -103,6 +103,25 @@ TEST(ScanFusion, DepthIsUndistortedBeforeIntegration) {
   EXPECT_LT(distance[distance.size() * 95 / 100], 0.0006);
 }
 
+// Given a view whose cameras have colour images, when fused, then the surface has their colour.
+TEST(ScanFusion, ColourComesFromTheColourImages) {
+  const auto rig = test::twoCameraRig();
+  auto view =
+      test::renderView(rig, test::sphereScene(0.05, {0, 0, 0.8}), test::tableAxis(), 0, "colour");
+  for (auto& camera : view.cameras) {
+    camera.colour.assign(camera.depth.size(), {200, 40, 10});
+  }
+  auto tsdf = Tsdf::create(rig, {.voxelM = 0.002, .truncationM = 0.008});
+  ASSERT_TRUE(tsdf.has_value());
+  ASSERT_TRUE(tsdf->integrate(view, Pose::Identity()).has_value());
+  const auto cloud = tsdf->extractCloud();
+  ASSERT_FALSE(cloud.empty());
+  ASSERT_EQ(cloud.colours.size(), cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); i += 97) {
+    EXPECT_LT((cloud.colours[i] - Eigen::Vector3d(200, 40, 10) / 255.0).norm(), 0.02);
+  }
+}
+
 // Given the same views without their poses and without an axis, and one view that has nothing
 // to do with the others, when fused, then that view is refused with its reason.
 TEST_F(ScanFusionSphere, AViewThatDoesNotOverlapIsRefusedWithItsReason) {

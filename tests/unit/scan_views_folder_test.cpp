@@ -167,6 +167,11 @@ TEST_F(ScanViewsFolder, FuseWritesTheModelOrNothing) {
   std::ifstream again(noAxis / "report.json");
   EXPECT_EQ(nlohmann::json::parse(again)["placement"], "turntable");
   EXPECT_EQ(::smx::test::runCli({"fuse", noAxis.string(), "--axis", "0,-1,0"}).code, 1);
+  run = ::smx::test::runCli({"fuse", dir_.string(), "--out", (dir_ / "closed").string(), "--voxel",
+                             "2", "--watertight", "--hole-max", "8"});
+  ASSERT_EQ(run.code, 0) << run.out << run.err;
+  std::ifstream closed(dir_ / "closed" / "report.json");
+  EXPECT_EQ(nlohmann::json::parse(closed)["watertight"], true);
 
   // Two views of different spheres far apart, no poses, no axis.
   const auto bad = dir_ / "bad";
