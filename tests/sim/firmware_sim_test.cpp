@@ -21,6 +21,7 @@
 #include "smx/hal/board_hal.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
+#include "smx/scan/views_folder.hpp"
 #include "smx/sim/png_io.hpp"
 #include "smx/sim/sim_board.hpp"
 #include "source_dir.hpp"
@@ -314,6 +315,11 @@ TEST_F(FirmwareSim, StreamCommandWritesTheConfidenceBesideEachDepth) {
     ++pairs;
   }
   EXPECT_GE(pairs, 2);
+  // The folder is a views folder `stripemux fuse` reads: the rig beside the frames.
+  const auto folder = scan::readViewsFolder(out);
+  ASSERT_TRUE(folder.has_value()) << folder.error();
+  EXPECT_EQ(folder->rig.cameras.size(), 1U);
+  EXPECT_GE(folder->views.size(), 2U);
 }
 
 TEST_F(FirmwareSim, AHostCanLeaveAndAnotherConnect) {

@@ -31,6 +31,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addPairCommand(app, io, exitCode);
   addFlashCommand(app, io, exitCode);
   addTurntableCommand(app, io, exitCode);
+  addFuseCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -15,6 +15,7 @@
 #include "device_option.hpp"
 #include "output_files.hpp"
 #include "point_cloud.hpp"
+#include "smx/config/rig_json.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/wire.hpp"
 #include "smx/sim/ply_io.hpp"
@@ -184,6 +185,7 @@ Json streamSummary(const StreamTally& tally, const DeviceInfo& info, const Strea
   summary["device"] = info.address;
   summary["board"] = info.board;
   summary["firmware"] = info.firmwareVersion;
+  summary["depth_unit_m"] = info.depthUnitM;
   summary["frames_received"] = tally.frames;
   for (const auto& [camera, count] : tally.perCamera) {
     summary["frames_per_camera"][info.rig.cameras[static_cast<std::size_t>(camera)].id] = count;
@@ -234,7 +236,7 @@ void printSummary(const StreamTally& tally, const DeviceInfo& info, const Stream
   out << "\n";
   out << "wrote " << opts.out.string() << "/<camera>_<n>.depth.png"
       << (opts.confidence ? ", .confidence.png" : "") << (opts.noPly ? "" : " and .ply") << ", "
-      << merged << ", <camera>.preview.png and summary.json\n";
+      << merged << ", <camera>.preview.png, rig.json and summary.json\n";
 }
 
 // Each frame's files appear complete or not at all; a stream that fails keeps the frames it
@@ -333,6 +335,16 @@ int runStream(const StreamOptions& opts, const CliStreams& io) {
     return kExitDeviceOrIo;
   }
   io.out << "connected to " << info.address << ": " << describe(info) << "\n";
+  // The rig the frames were decoded with, so that the folder can be fused later
+  // (docs/scanning.md): complete before the first frame arrives.
+  if (auto ok = out->writeText("rig.json", config::toJson(info.rig)); !ok) {
+    io.err << "stripemux stream: " << ok.error() << "\n";
+    return kExitDeviceOrIo;
+  }
+  if (auto ok = out->commit(); !ok) {
+    io.err << "stripemux stream: " << ok.error() << "\n";
+    return kExitDeviceOrIo;
+  }
   if (auto started = client->startStream(compression, opts.confidence); !started) {
     io.err << "stripemux stream: " << printable(started.error()) << "\n";
     return kExitDeviceOrIo;

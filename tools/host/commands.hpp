@@ -24,5 +24,6 @@ void addVerifyBundleCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addPairCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addTurntableCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addFuseCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

@@ -77,6 +77,14 @@ std::expected<Registration, std::string> registerIcp(const Cloud& source, const 
                              reg::ICPConvergenceCriteria(1e-7, 1e-7, options.iterationsPerLevel));
     pose = result.transformation_;
   }
+  // A surface that does not fix every degree of freedom (a sphere, a plane) leaves the
+  // point-to-plane system singular and ICP can run away from a good start: keep the start when
+  // it fits better than where ICP ended.
+  const auto start = reg::EvaluateRegistration(*src, *tgt, maxDistance, initial.matrix());
+  if (!pose.allFinite() || result.fitness_ < start.fitness_ - 0.01) {
+    result = start;
+    pose = initial.matrix();
+  }
   Registration out;
   out.pose = Pose(pose);
   out.fitness = result.fitness_;

@@ -32,7 +32,7 @@ struct ViewsFolder {
 // (frames with every rig camera's image; depth unit from DIR/summary.json "depth_unit_m", else
 // 1e-4 m). At most `maxViews` views are read.
 [[nodiscard]] std::expected<ViewsFolder, std::string> readViewsFolder(
-    const std::filesystem::path& dir, std::size_t maxViews = 10000);
+    const std::filesystem::path& dir, std::size_t maxViews = 1000);
 
 // One entry of views.json.
 struct ViewEntry {
