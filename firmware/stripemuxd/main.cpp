@@ -81,6 +81,7 @@ bool serve(Device& device, const Options& opts, std::size_t cameras, std::atomic
   clock_gettime(CLOCK_MONOTONIC, &last);
   while (!stop && !device.restartDue()) {
     (void)device.serveRawCapture();  // between range captures, when a host asked for one
+    (void)device.serveTurn();        // and a turntable move
     (void)device.captureOnce();
     if (opts.frames > 0 && device.counters().framesCaptured >= opts.frames * cameras) {
       stop = true;

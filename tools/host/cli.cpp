@@ -32,6 +32,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addFlashCommand(app, io, exitCode);
   addTurntableCommand(app, io, exitCode);
   addFuseCommand(app, io, exitCode);
+  addScanCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -129,13 +129,18 @@ int runScanEval(const EvalOptions& o, const CliStreams& io) {
   turntable.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
   try {
     const auto result = scan_eval::runTurntableEval(turntable);
+    scan_eval::HandheldEvalOptions handheld;
+    handheld.seed = o.seed;
+    handheld.supersampling = o.supersampling;
+    handheld.progress = turntable.progress;
+    const auto carried = scan_eval::runHandheldEval(handheld);
     auto out = OutputFolder::create(o.out);
     if (!out) {
       io.err << "stripemux eval: " << out.error() << '\n';
       return kExitDeviceOrIo;
     }
     if (auto ok = out->writeText("scan-results.md",
-                                 scan_eval::scanResultsMarkdown(result, commandLine(o)));
+                                 scan_eval::scanResultsMarkdown(result, carried, commandLine(o)));
         !ok || !out->commit()) {
       io.err << "stripemux eval: cannot write " << (o.out / "scan-results.md").string() << '\n';
       return kExitDeviceOrIo;

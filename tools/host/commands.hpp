@@ -25,5 +25,6 @@ void addPairCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addTurntableCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addFuseCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

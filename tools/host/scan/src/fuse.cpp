@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "smx/scan/table_crop.hpp"
 #include "smx/scan/watertight.hpp"
 
 namespace smx::scan {
@@ -210,11 +211,23 @@ class Fuser {
 
 }  // namespace
 
-std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& views,
+std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& input,
                                                const algo::Rig& rig,
                                                const std::vector<std::optional<Pose>>& givenPoses,
                                                const FuseOptions& options) {
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
+  // A turntable's views keep only what turns with the table.
+  std::vector<RangeView> onTable;
+  const bool turntable =
+      options.axis && options.tableRadiusM > 0 && !input.empty() &&
+      std::ranges::all_of(input, [](const RangeView& v) { return v.turntableDeg.has_value(); });
+  if (turntable) {
+    onTable = input;
+    for (auto& view : onTable) {
+      keepOnTable(view, rig, *options.axis, options.tableRadiusM);
+    }
+  }
+  const std::vector<RangeView>& views = turntable ? onTable : input;
   FuseReport report;
   const auto failWith = [&report](std::string message) {
     return std::unexpected(FuseError{std::move(message), report});

@@ -1,7 +1,6 @@
 #include "smx/scan_eval/turntable_eval.hpp"
 
 #include <open3d/Open3D.h>
-#include <open3d/t/geometry/RaycastingScene.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include "smx/eval/sim_frame.hpp"
 #include "smx/scan/fuse.hpp"
 #include "smx/text/printf_text.hpp"
+#include "truth_surface.hpp"
 
 namespace smx::scan_eval {
 
@@ -57,48 +57,12 @@ sim::Scene turned(const sim::Scene& scene, double deg) {
   return out;
 }
 
-// An object's surface in the world frame, as triangles.
-std::shared_ptr<open3d::geometry::TriangleMesh> surfaceOf(const sim::Object& object) {
-  using open3d::geometry::TriangleMesh;
-  std::shared_ptr<TriangleMesh> mesh;
-  if (const auto* m = std::get_if<sim::Mesh>(&object.shape)) {
-    mesh = std::make_shared<TriangleMesh>();
-    for (const auto& v : m->vertices) {
-      mesh->vertices_.push_back(v.cast<double>());
-    }
-    for (const auto& t : m->triangles) {
-      mesh->triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
-                                    static_cast<int>(t[2]));
-    }
-  } else if (const auto* c = std::get_if<sim::Cylinder>(&object.shape)) {
-    // Open3D's cylinder runs along z; the scene's along local y.
-    mesh = TriangleMesh::CreateCylinder(c->radiusM, c->heightM, 128, 4);
-    mesh->Rotate(Eigen::Matrix3d(Eigen::AngleAxisd(-std::numbers::pi / 2, Vec3::UnitX())),
-                 Vec3::Zero());
-  } else if (const auto* s = std::get_if<sim::Sphere>(&object.shape)) {
-    mesh = TriangleMesh::CreateSphere(s->radiusM, 64);
-  } else if (const auto* b = std::get_if<sim::Box>(&object.shape)) {
-    mesh = TriangleMesh::CreateBox(b->sizeM.x(), b->sizeM.y(), b->sizeM.z());
-    mesh->Translate(-0.5 * b->sizeM);
-  } else if (const auto* p = std::get_if<sim::Plane>(&object.shape)) {
-    mesh = std::make_shared<TriangleMesh>();
-    const double w = p->widthM / 2;
-    const double h = p->heightM / 2;
-    mesh->vertices_ = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
-    mesh->triangles_ = {{0, 1, 2}, {0, 2, 3}};
-  }
-  for (auto& v : mesh->vertices_) {
-    v = object.pose.R * (object.pose.scale * v) + object.pose.t;
-  }
-  return mesh;
-}
-
 // The objects standing on the table, at angle 0: the model's frame.
 open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene) {
   open3d::geometry::TriangleMesh all;
   for (const auto& object : scene.objects) {
     if (object.onTurntable) {
-      all += *surfaceOf(object);
+      all += detail::objectSurface(object);
     }
   }
   if (all.triangles_.empty()) {
@@ -156,15 +120,6 @@ void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scen
   }
 }
 
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) {
-    return 0.0;
-  }
-  const auto k = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1));
-  std::ranges::nth_element(values, values.begin() + static_cast<std::ptrdiff_t>(k));
-  return values[k];
-}
-
 }  // namespace
 
 TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
@@ -216,6 +171,7 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   scan::FuseOptions fuse;
   fuse.voxelM = options.voxelM;
   fuse.axis = scan::TurntableAxis{.direction = mount.axis.normalized(), .point = mount.pivot};
+  fuse.tableRadiusM = options.tableRadiusM;
   const auto fuseStart = Clock::now();
   auto fused = scan::fuseViews(views, rig, {}, fuse);
   result.fuseS = seconds(fuseStart);
@@ -231,26 +187,9 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   }
 
   // Vertices to the true surface.
-  open3d::t::geometry::RaycastingScene raycast;
-  raycast.AddTriangles(open3d::t::geometry::TriangleMesh::FromLegacy(truth));
-  std::vector<float> query;
-  query.reserve(vertices.size() * 3);
-  for (const auto& v : vertices) {
-    query.insert(query.end(),
-                 {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
-  }
-  const open3d::core::Tensor points(query, {static_cast<std::int64_t>(vertices.size()), 3},
-                                    open3d::core::Float32);
-  const auto distances = raycast.ComputeDistance(points);
-  const float* d = distances.GetDataPtr<float>();
-  std::vector<double> mm(d, d + vertices.size());
-  double sum = 0.0;
-  for (double& v : mm) {
-    v *= 1000.0;
-    sum += v;
-  }
-  result.meanMm = sum / static_cast<double>(mm.size());
-  result.p95Mm = percentile(mm, 0.95);
+  const auto distance = detail::distancesToSurface(vertices, truth);
+  result.meanMm = distance.meanMm;
+  result.p95Mm = distance.p95Mm;
 
   // The seen surface within reach of the mesh.
   open3d::geometry::PointCloud meshPoints;

@@ -23,9 +23,12 @@ struct FuseOptions {
   bool watertight = false;              // mesh by Screened Poisson instead of the TSDF's surface
   double holeMaxM = 0.005;              // with watertight: holes up to this are closed
   std::optional<TurntableAxis> axis{};  // places views with turntable angles
-  bool refine = false;                  // refine poses given by the caller too
-  double minFitness = 0.3;              // a view registering below this is refused
-  double registrationVoxelM = 0.002;    // the clouds registration works on (finest ICP level)
+  // With turntable angles and an axis: only points within this of the axis are used (what stands
+  // on the table; table_crop.hpp). 0: every point.
+  double tableRadiusM = 0.25;
+  bool refine = false;                // refine poses given by the caller too
+  double minFitness = 0.3;            // a view registering below this is refused
+  double registrationVoxelM = 0.002;  // the clouds registration works on (finest ICP level)
   std::function<void(std::string_view)> progress{};  // one line per step, when set
 };
 

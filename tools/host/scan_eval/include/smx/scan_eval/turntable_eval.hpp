@@ -15,7 +15,8 @@ struct TurntableEvalOptions {
   std::string rigFile = "rig_2proj_1cam.json";  // boards/sim/<rigFile>
   int views = 24;
   double voxelM = 0.001;
-  int supersampling = 0;  // 0: the scene's own
+  double tableRadiusM = 0.25;  // the scan volume round the table's axis
+  int supersampling = 0;       // 0: the scene's own
   std::uint64_t seed = 1;
   std::function<void(const std::string&)> progress{};
 };

@@ -1,0 +1,240 @@
+// stripemux scan --device HOST[:PORT] --turntable [--views N] --out DIR [fuse options]
+// stripemux scan --device HOST[:PORT] --handheld [--frames N] --out DIR [fuse options]
+// A whole object in one model (docs/scanning.md). Turntable: the device turns its table through N
+// views and the host keeps each view's range images and colour in DIR/views as they arrive.
+// Hand-held: every capture is tracked against the model so far as it arrives, until Ctrl-C or N
+// captures; the well-tracked ones go to DIR/views with their poses. Then both are fused and
+// meshed as `stripemux fuse DIR` does.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "device_client.hpp"
+#include "device_option.hpp"
+#include "fuse_runner.hpp"
+#include "scan_handheld.hpp"
+#include "scan_turntable.hpp"
+#include "scan_views_writer.hpp"
+#include "smx/text/printf_text.hpp"
+#include "terminal_text.hpp"
+
+namespace smx::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ScanOptions {
+  std::string device;
+  fs::path out;
+  bool turntable = false;
+  int views = 24;
+  bool handheld = false;
+  int frames = 0;
+  bool noColour = false;
+  FuseFolderOptions fuse;
+};
+
+int fail(const CliStreams& io, int code, const std::string& message) {
+  io.err << "stripemux scan: " << printable(message) << "\n";
+  return code;
+}
+
+// "[#####·····] 5/24 views, 75.0°, 183412 points"
+std::string progressLine(const TurntableStep& step) {
+  constexpr int kWidth = 24;
+  const int filled = (step.view + 1) * kWidth / step.views;
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.append(static_cast<std::size_t>(kWidth - filled), '.');
+  return "[" + bar +
+         text::printfText("] %d/%d views, table at %.1f°, %zu points", step.view + 1, step.views,
+                          step.angleDeg, step.points);
+}
+
+int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
+  auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
+  if (!client) {
+    return fail(io, kExitDeviceOrIo, client.error());
+  }
+  const DeviceInfo& info = client->info();
+  if (!info.rig.turntable) {
+    return fail(io, kExitBadInput,
+                "the device's rig has no turntable axis: calibrate it (stripemux calibrate "
+                "--turntable) and install the rig (stripemux config set rig=RIG.json)");
+  }
+  auto writer = ViewsWriter::create(opts.out, info.rig, info.rigJson, scan::ScanMode::kTurntable);
+  if (!writer) {
+    return fail(io, kExitDeviceOrIo, writer.error());
+  }
+  io.out << "connected to " << printable(info.address) << ": " << printable(info.board) << ", "
+         << info.cameras << " cameras; " << opts.views << " views into "
+         << (opts.out / "views").string() << "\n";
+  const auto start = std::chrono::steady_clock::now();
+  const TurntableCaptureOptions capture{.views = opts.views, .colour = !opts.noColour};
+  auto views =
+      captureTurntableViews(*client, capture,
+                            [&](const scan::RangeView& view,
+                                const TurntableStep& step) -> std::expected<void, std::string> {
+                              if (auto ok = writer->add(view); !ok) {
+                                return ok;
+                              }
+                              io.out << progressLine(step) << "\n" << std::flush;
+                              return {};
+                            });
+  if (!views) {
+    const bool absent = views.error().starts_with("the device has no turntable");
+    return fail(io, absent ? kExitBadInput : kExitDeviceOrIo, views.error());
+  }
+  client->close();
+  if (auto ok = writer->finish({}); !ok) {
+    return fail(io, kExitDeviceOrIo, ok.error());
+  }
+  const double captureS =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  io.out << "captured " << views->size() << " views in " << std::lround(captureS) << " s; fusing\n";
+  FuseFolderOptions fuse = opts.fuse;
+  fuse.dir = opts.out.string();
+  fuse.out = opts.out.string();
+  return runFuseFolder(fuse, io, "stripemux scan");
+}
+
+// Ctrl-C ends a hand-held scan the way --frames does: the stream stops and the model is made.
+std::atomic<bool> interrupted{false};
+extern "C" void onInterrupt(int /*signal*/) {
+  interrupted.store(true);
+}
+
+const char* stateName(const scan::TrackResult& r) {
+  if (r.state == scan::TrackingState::kLost) {
+    return "LOST";
+  }
+  if (r.state == scan::TrackingState::kRelocalised) {
+    return "relocalised";
+  }
+  return r.quality.good ? "tracking" : "weak";
+}
+
+int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
+  auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
+  if (!client) {
+    return fail(io, kExitDeviceOrIo, client.error());
+  }
+  const DeviceInfo& info = client->info();
+  auto tracker = scan::Tracker::create(info.rig);
+  if (!tracker) {
+    return fail(io, kExitBadInput, tracker.error());
+  }
+  auto writer = ViewsWriter::create(opts.out, info.rig, info.rigJson, scan::ScanMode::kHandheld);
+  if (!writer) {
+    return fail(io, kExitDeviceOrIo, writer.error());
+  }
+  io.out << "connected to " << printable(info.address) << ": " << printable(info.board) << ", "
+         << info.cameras << " cameras at " << info.fps << " fps; move round the object, "
+         << (opts.frames > 0 ? "stops after " + std::to_string(opts.frames) + " captures"
+                             : std::string("Ctrl-C to stop"))
+         << "\n";
+  std::vector<std::optional<scan::Pose>> poses;
+  auto lastLine = std::chrono::steady_clock::now();
+  scan::TrackingState lastState = scan::TrackingState::kTracking;
+  interrupted.store(false);
+  const auto previous = std::signal(SIGINT, onInterrupt);
+  const HandheldCaptureOptions capture{.frames = opts.frames};
+  int captures = 0;
+  int fused = 0;
+  auto tally = trackHandheld(
+      *client, *tracker, capture, interrupted,
+      [&](const scan::RangeView& view,
+          const scan::TrackResult& result) -> std::expected<void, std::string> {
+        ++captures;
+        if (result.fused) {
+          ++fused;
+          if (auto ok = writer->add(view); !ok) {
+            return ok;
+          }
+          poses.emplace_back(result.pose);
+        }
+        // A line twice a second, and at once when tracking is lost or found again.
+        const auto now = std::chrono::steady_clock::now();
+        if (now - lastLine >= std::chrono::milliseconds(500) || result.state != lastState) {
+          lastLine = now;
+          io.out << text::printfText(
+                        "  capture %d: %-11s fitness %.2f, %.2f mm, score %.2f; %d fused, %zu "
+                        "keyframes",
+                        captures, stateName(result), result.quality.fitness,
+                        result.quality.inlierRmseMm, result.quality.score, fused,
+                        tracker->keyframes())
+                 << (result.reason.empty() ? "" : " (" + result.reason + ")") << "\n"
+                 << std::flush;
+        }
+        lastState = result.state;
+        return {};
+      });
+  std::signal(SIGINT, previous);
+  if (!tally) {
+    return fail(io, kExitDeviceOrIo, tally.error());
+  }
+  client->close();
+  if (auto ok = writer->finish(poses); !ok) {
+    return fail(io, kExitDeviceOrIo, ok.error());
+  }
+  const double trackMs = tally->captures > 0 ? tally->trackMsTotal / tally->captures : 0.0;
+  io.out << text::printfText(
+      "%d captures: %d fused, %d lost, %d relocalised; tracking %.1f ms a capture; the device "
+      "dropped %llu frames the host was too slow for\n",
+      tally->captures, tally->fused, tally->lost, tally->relocalised, trackMs,
+      static_cast<unsigned long long>(tally->device.framesDropped));
+  if (tally->fused < 2) {
+    return fail(io, kExitBadInput,
+                "only " + std::to_string(tally->fused) +
+                    " captures tracked well enough to fuse: scan again, moving slowly over the "
+                    "object and keeping it in view");
+  }
+  FuseFolderOptions fuse = opts.fuse;
+  fuse.dir = opts.out.string();
+  fuse.out = opts.out.string();
+  fuse.tracking = {
+      {"captures", tally->captures}, {"fused", tally->fused},
+      {"lost", tally->lost},         {"relocalised", tally->relocalised},
+      {"track_ms_mean", trackMs},    {"device_frames_dropped", tally->device.framesDropped}};
+  return runFuseFolder(fuse, io, "stripemux scan");
+}
+
+}  // namespace
+
+void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
+  auto opts = std::make_shared<ScanOptions>();
+  auto* cmd = app.add_subcommand("scan",
+                                 "Scan a whole object into one model: turntable views or a "
+                                 "hand-held stream, fused and meshed");
+  cmd->add_option("--device", opts->device, "HOST[:PORT] of the device")
+      ->required()
+      ->check(deviceAddressValidator());
+  cmd->add_option("--out", opts->out, "Folder for the views and the model")->required();
+  auto* turntable =
+      cmd->add_flag("--turntable", opts->turntable, "Turn the device's table through the views");
+  cmd->add_option("--views", opts->views, "Views over one turn of the table (default 24)")
+      ->check(CLI::Range(2, 360))
+      ->needs(turntable);
+  auto* handheld = cmd->add_flag("--handheld", opts->handheld,
+                                 "Track and fuse the stream while the scanner is moved by hand");
+  handheld->excludes(turntable);
+  cmd->add_option("--frames", opts->frames,
+                  "With --handheld: stop after N captures (default: "
+                  "Ctrl-C)")
+      ->check(CLI::Range(1, 100000))
+      ->needs(handheld);
+  cmd->add_flag("--no-colour", opts->noColour,
+                "Skip the projector-off frame of each view (the model is grey)");
+  addFuseOptions(*cmd, opts->fuse);
+  cmd->callback([opts, &io, &exitCode] {
+    if (!opts->turntable && !opts->handheld) {
+      exitCode = fail(io, kExitUsage, "give --turntable or --handheld");
+      return;
+    }
+    exitCode = opts->turntable ? runTurntableScan(*opts, io) : runHandheldScan(*opts, io);
+  });
+}
+
+}  // namespace smx::host

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli.hpp"
+
+// Registration, fusion and meshing of a views folder into the scan's outputs
+// (docs/scanning.md): what `stripemux fuse` does, and `stripemux scan` after its captures.
+namespace smx::host {
+
+struct FuseFolderOptions {
+  std::string dir;
+  std::string out;  // empty: dir
+  double voxelMm = 1.0;
+  bool watertight = false;
+  double holeMaxMm = 5.0;
+  std::vector<double> axis;  // empty, or X,Y,Z with axisPoint
+  std::vector<double> axisPoint;
+  bool refine = false;
+  double minFitness = 0.3;
+  double tableRadiusMm = 250.0;
+  nlohmann::json tracking{};  // a hand-held scan's tracking figures, report.json's "tracking"
+};
+
+// The options fuse and scan share: --voxel, --watertight, --hole-max, --table-radius,
+// --min-fitness.
+void addFuseOptions(CLI::App& cmd, FuseFolderOptions& opts);
+
+// DIR2 gets model.ply, mesh.ply, mesh.obj, mesh.stl, report.json and views/poses.json, all or
+// none. Returns the exit code; messages start with `command`.
+[[nodiscard]] int runFuseFolder(const FuseFolderOptions& opts, const CliStreams& io,
+                                std::string_view command);
+
+}  // namespace smx::host

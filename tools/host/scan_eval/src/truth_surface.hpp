@@ -1,0 +1,26 @@
+#pragma once
+
+#include <open3d/geometry/TriangleMesh.h>
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "smx/sim/scene.hpp"
+
+// The simulator's objects as triangles, and a fused mesh measured against them.
+namespace smx::scan_eval::detail {
+
+// `object`'s surface, moved by `to` after its pose (world → model frame).
+[[nodiscard]] open3d::geometry::TriangleMesh objectSurface(
+    const sim::Object& object, const Eigen::Isometry3d& to = Eigen::Isometry3d::Identity());
+
+struct DistanceStats {
+  double meanMm = 0.0;
+  double p95Mm = 0.0;
+};
+
+// Every vertex's distance to the surface.
+[[nodiscard]] DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,
+                                               const open3d::geometry::TriangleMesh& surface);
+
+}  // namespace smx::scan_eval::detail
