@@ -67,7 +67,8 @@ Json reportJson(const scan::FuseReport& report, const scan::FuseResult* result,
                     {"extent_max_m", vectorJson(report.extentMax)},
                     {"size_mm", vectorJson((report.extentMax - report.extentMin) * 1e3)}};
     doc["mesh"] = {{"vertices", result->mesh.vertices.size()},
-                   {"triangles", result->mesh.triangles.size()}};
+                   {"triangles", result->mesh.triangles.size()},
+                   {"loose_pieces_removed", report.loosePiecesRemoved}};
   }
   doc["seconds"] = {{"registration", report.registrationS},
                     {"fusion", report.fusionS},

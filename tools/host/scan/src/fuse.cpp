@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "smx/scan/model_cleanup.hpp"
+#include "smx/scan/range_clean.hpp"
 #include "smx/scan/table_crop.hpp"
 #include "smx/scan/watertight.hpp"
 
@@ -216,18 +218,18 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
                                                const std::vector<std::optional<Pose>>& givenPoses,
                                                const FuseOptions& options) {
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
-  // A turntable's views keep only what turns with the table.
-  std::vector<RangeView> onTable;
+  // What the model takes of each view: a turntable's views only what turns with the table, and
+  // no view its edges or grazing pixels.
+  std::vector<RangeView> views = input;
   const bool turntable =
       options.axis && options.tableRadiusM > 0 && !input.empty() &&
       std::ranges::all_of(input, [](const RangeView& v) { return v.turntableDeg.has_value(); });
-  if (turntable) {
-    onTable = input;
-    for (auto& view : onTable) {
+  for (auto& view : views) {
+    if (turntable) {
       keepOnTable(view, rig, *options.axis, options.tableRadiusM);
     }
+    cleanForFusion(view, rig, options.clean);
   }
-  const std::vector<RangeView>& views = turntable ? onTable : input;
   FuseReport report;
   const auto failWith = [&report](std::string message) {
     return std::unexpected(FuseError{std::move(message), report});
@@ -323,6 +325,16 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
   start = Clock::now();
   FuseResult result;
   result.model = tsdf->extractCloud();
+  result.mesh = tsdf->extractMesh();
+  if (options.minPieceShare > 0) {
+    const auto cleanup =
+        removeLoosePieces(result.mesh, result.model, options.minPieceShare, options.voxelM);
+    report.loosePiecesRemoved = cleanup.piecesRemoved;
+    if (cleanup.piecesRemoved > 0) {
+      fuser.say("removed " + std::to_string(cleanup.piecesRemoved) + " loose pieces (" +
+                std::to_string(cleanup.trianglesRemoved) + " triangles) apart from the model");
+    }
+  }
   if (options.watertight) {
     auto mesh =
         watertightMesh(result.model, {.voxelM = options.voxelM, .holeMaxM = options.holeMaxM});
@@ -330,8 +342,6 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
       return failWith(mesh.error());
     }
     result.mesh = std::move(*mesh);
-  } else {
-    result.mesh = tsdf->extractMesh();
   }
   report.meshingS = secondsSince(start);
   if (!result.model.empty()) {

@@ -9,7 +9,7 @@
 
 #include "smx/eval/frame_eval.hpp"
 #include "smx/eval/sim_frame.hpp"
-#include "smx/scan/fusion.hpp"
+#include "smx/scan/fuse.hpp"
 #include "smx/scan/tracker.hpp"
 #include "smx/sim/handheld.hpp"
 #include "smx/text/printf_text.hpp"
@@ -144,18 +144,15 @@ HandheldEvalResult runHandheldEval(const HandheldEvalOptions& options) {
   result.trackMsMean = trackMs.empty() ? 0.0 : sumMs / static_cast<double>(trackMs.size());
   result.trackMsP95 = percentile(trackMs, 0.95);
 
-  // The fused frames at their tracked poses into one TSDF, as the scan's model.
-  auto tsdf = scan::Tsdf::create(
-      rig, {.voxelM = options.voxelM, .truncationM = 4 * options.voxelM, .maxDepthM = 1.5});
-  if (!tsdf) {
-    throw std::runtime_error("fusion: " + tsdf.error());
+  // The fused frames at their tracked poses, fused as the scan command's fuse step does.
+  std::vector<std::optional<scan::Pose>> given(fusedPoses.begin(), fusedPoses.end());
+  scan::FuseOptions fuse;
+  fuse.voxelM = options.voxelM;
+  auto fused = scan::fuseViews(fusedViews, rig, given, fuse);
+  if (!fused) {
+    throw std::runtime_error("fusing the tracked frames: " + fused.error().message);
   }
-  for (std::size_t i = 0; i < fusedViews.size(); ++i) {
-    if (auto ok = tsdf->integrate(fusedViews[i], fusedPoses[i]); !ok) {
-      throw std::runtime_error("fusion: " + ok.error());
-    }
-  }
-  const scan::Mesh mesh = tsdf->extractMesh();
+  const scan::Mesh& mesh = fused->mesh;
   open3d::geometry::TriangleMesh truth;
   for (const auto& object : scene.objects) {
     truth += detail::objectSurface(object, first.inverse());

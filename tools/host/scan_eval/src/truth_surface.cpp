@@ -3,6 +3,7 @@
 #include <open3d/t/geometry/RaycastingScene.h>
 
 #include <algorithm>
+#include <limits>
 #include <numbers>
 #include <variant>
 
@@ -61,25 +62,45 @@ open3d::geometry::TriangleMesh objectSurface(const sim::Object& object,
   return *mesh;
 }
 
+namespace {
+
+// Every point's distance to the surface, metres.
+std::vector<double> distances(const std::vector<Eigen::Vector3d>& points,
+                              const open3d::geometry::TriangleMesh& surface) {
+  if (points.empty() || surface.triangles_.empty()) {
+    return std::vector<double>(points.size(), std::numeric_limits<double>::infinity());
+  }
+  open3d::t::geometry::RaycastingScene raycast;
+  raycast.AddTriangles(open3d::t::geometry::TriangleMesh::FromLegacy(surface));
+  std::vector<float> query;
+  query.reserve(points.size() * 3);
+  for (const auto& v : points) {
+    query.insert(query.end(),
+                 {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
+  }
+  const open3d::core::Tensor tensor(query, {static_cast<std::int64_t>(points.size()), 3},
+                                    open3d::core::Float32);
+  const auto result = raycast.ComputeDistance(tensor);
+  const float* d = result.GetDataPtr<float>();
+  return {d, d + points.size()};
+}
+
+}  // namespace
+
+std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
+                        const open3d::geometry::TriangleMesh& surface, double distanceM) {
+  const auto d = distances(points, surface);
+  return static_cast<std::size_t>(
+      std::ranges::count_if(d, [&](double v) { return v <= distanceM; }));
+}
+
 DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,
                                  const open3d::geometry::TriangleMesh& surface) {
   DistanceStats stats;
   if (vertices.empty()) {
     return stats;
   }
-  open3d::t::geometry::RaycastingScene raycast;
-  raycast.AddTriangles(open3d::t::geometry::TriangleMesh::FromLegacy(surface));
-  std::vector<float> query;
-  query.reserve(vertices.size() * 3);
-  for (const auto& v : vertices) {
-    query.insert(query.end(),
-                 {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
-  }
-  const open3d::core::Tensor points(query, {static_cast<std::int64_t>(vertices.size()), 3},
-                                    open3d::core::Float32);
-  const auto distances = raycast.ComputeDistance(points);
-  const float* d = distances.GetDataPtr<float>();
-  std::vector<double> mm(d, d + vertices.size());
+  std::vector<double> mm = distances(vertices, surface);
   double sum = 0.0;
   for (double& v : mm) {
     v *= 1000.0;

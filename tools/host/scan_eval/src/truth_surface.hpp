@@ -23,4 +23,9 @@ struct DistanceStats {
 [[nodiscard]] DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,
                                                const open3d::geometry::TriangleMesh& surface);
 
+// How many of `points` lie within `distanceM` of the surface.
+[[nodiscard]] std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
+                                      const open3d::geometry::TriangleMesh& surface,
+                                      double distanceM);
+
 }  // namespace smx::scan_eval::detail

@@ -191,24 +191,18 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   result.meanMm = distance.meanMm;
   result.p95Mm = distance.p95Mm;
 
-  // The seen surface within reach of the mesh.
-  open3d::geometry::PointCloud meshPoints;
-  meshPoints.points_ = vertices;
-  const open3d::geometry::KDTreeFlann tree(meshPoints);
-  std::size_t visible = 0;
-  std::size_t covered = 0;
-  std::vector<int> index(1);
-  std::vector<double> distance2(1);
+  // The seen surface within reach of the mesh's triangles.
+  open3d::geometry::TriangleMesh fusedMesh;
+  fusedMesh.vertices_ = vertices;
+  fusedMesh.triangles_ = fused->mesh.triangles;
+  std::vector<Vec3> seenSamples;
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (seen[i] == 0) {
-      continue;
-    }
-    ++visible;
-    if (tree.SearchKNN(samples[i], 1, index, distance2) > 0 &&
-        distance2[0] <= kCoveredM * kCoveredM) {
-      ++covered;
+    if (seen[i] != 0) {
+      seenSamples.push_back(samples[i]);
     }
   }
+  const std::size_t visible = seenSamples.size();
+  const std::size_t covered = detail::countWithin(seenSamples, fusedMesh, kCoveredM);
   result.coverage = visible > 0 ? static_cast<double>(covered) / static_cast<double>(visible) : 0;
   return result;
 }

@@ -10,6 +10,7 @@
 #include "smx/algo/rig.hpp"
 #include "smx/scan/fusion.hpp"
 #include "smx/scan/points.hpp"
+#include "smx/scan/range_clean.hpp"
 #include "smx/scan/range_view.hpp"
 #include "smx/scan/registration.hpp"
 
@@ -26,6 +27,11 @@ struct FuseOptions {
   // With turntable angles and an axis: only points within this of the axis are used (what stands
   // on the table; table_crop.hpp). 0: every point.
   double tableRadiusM = 0.25;
+  // Range pixels a model should not take (range_clean.hpp); edgePx 0 and 90° keep every pixel.
+  RangeCleanOptions clean{};
+  // Mesh pieces with fewer triangles than this share of the largest piece's are removed
+  // (model_cleanup.hpp); 0 keeps every piece.
+  double minPieceShare = 0.02;
   bool refine = false;                // refine poses given by the caller too
   double minFitness = 0.3;            // a view registering below this is refused
   double registrationVoxelM = 0.002;  // the clouds registration works on (finest ICP level)
@@ -48,6 +54,7 @@ struct FuseReport {
   Eigen::Vector3d extentMin = Eigen::Vector3d::Zero();  // the model's bounding box, model frame
   Eigen::Vector3d extentMax = Eigen::Vector3d::Zero();
   double loopClosureM = 0.0;  // turntable: gap between the last view's pose chained to the first
+  std::size_t loosePiecesRemoved = 0;  // model_cleanup.hpp
   double registrationS = 0.0;
   double fusionS = 0.0;
   double meshingS = 0.0;
