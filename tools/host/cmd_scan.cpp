@@ -53,12 +53,28 @@ std::string progressLine(const TurntableStep& step) {
                           step.angleDeg, step.points);
 }
 
+// Why a scan that needs a table cannot have one, and what to do instead.
+std::string noTurntable(const std::string& why) {
+  return why + ": scan the object by hand (--handheld) or on a device with a turntable";
+}
+
 int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
   }
   const DeviceInfo& info = client->info();
+  // A device without a table is told apart from a table without a calibrated axis: the advice
+  // differs.
+  const TurntableCaptureOptions capture{.views = opts.views, .colour = !opts.noColour};
+  auto table = client->turntableStatus(capture.frameTimeout);
+  if (!table && !table.error().absent) {
+    return fail(io, kExitDeviceOrIo, table.error().message);
+  }
+  if (!table || !table->present) {
+    return fail(io, kExitBadInput,
+                noTurntable(table ? "the device has no turntable" : table.error().message));
+  }
   if (!info.rig.turntable) {
     return fail(io, kExitBadInput,
                 "the device's rig has no turntable axis: calibrate it (stripemux calibrate "
@@ -72,7 +88,6 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
          << info.cameras << " cameras; " << opts.views << " views into "
          << (opts.out / "views").string() << "\n";
   const auto start = std::chrono::steady_clock::now();
-  const TurntableCaptureOptions capture{.views = opts.views, .colour = !opts.noColour};
   auto views =
       captureTurntableViews(*client, capture,
                             [&](const scan::RangeView& view,
