@@ -23,7 +23,6 @@ void addFuseCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--axis-point", opts->axisPoint, "A point on the turntable axis X,Y,Z, metres")
       ->delimiter(',')
       ->expected(3);
-  cmd->add_flag("--refine", opts->refine, "Refine poses given in views.json too");
   cmd->callback([opts, &io, &exitCode] { exitCode = runFuseFolder(*opts, io, "stripemux fuse"); });
 }
 

@@ -206,6 +206,9 @@ void addFuseOptions(CLI::App& cmd, FuseFolderOptions& opts) {
   cmd.add_option("--table-radius", opts.tableRadiusMm,
                  "Turntable views: only points within this of the axis, mm (default 250; 0 all)")
       ->check(CLI::Range(0.0, 10000.0));
+  cmd.add_flag("--refine", opts.refine,
+               "Refine given and turntable poses by registration and a pose graph (default: "
+               "given poses as they are, turntable views by their angles about the axis)");
   cmd.add_option("--min-fitness", opts.minFitness,
                  "A view registering to less than this share of points is refused (0.3)");
 }

@@ -26,7 +26,7 @@ struct FuseFolderOptions {
   nlohmann::json tracking{};  // a hand-held scan's tracking figures, report.json's "tracking"
 };
 
-// The options fuse and scan share: --voxel, --watertight, --hole-max, --table-radius,
+// The options fuse and scan share: --voxel, --watertight, --hole-max, --table-radius, --refine,
 // --min-fitness.
 void addFuseOptions(CLI::App& cmd, FuseFolderOptions& opts);
 

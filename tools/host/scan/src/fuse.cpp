@@ -117,8 +117,9 @@ class Fuser {
   }
 
   // Initial poses refined: each view registered to its next two neighbours (and the ring closed
-  // when `ring`), then a pose graph spreads the residuals so that the loop closes.
-  Placement refined(std::vector<Pose> initial, bool ring, FuseReport& report) {
+  // when `ring`), then, when `optimise`, a pose graph spreads the residuals so that the loop
+  // closes. Without it the poses stay as given and the registrations only judge the overlap.
+  Placement refined(std::vector<Pose> initial, bool ring, bool optimise, FuseReport& report) {
     Placement p = empty();
     p.poses = std::move(initial);
     const std::size_t n = views_.size();
@@ -179,7 +180,7 @@ class Fuser {
       }
     }
     const double before = loopGap(p.poses);
-    if (!graph.edges_.empty()) {
+    if (optimise && !graph.edges_.empty()) {
       const reg::GlobalOptimizationOption option(2 * options_.registrationVoxelM, 0.25, 1.0, 0);
       reg::GlobalOptimization(graph, reg::GlobalOptimizationLevenbergMarquardt(),
                               reg::GlobalOptimizationConvergenceCriteria(), option);
@@ -189,8 +190,9 @@ class Fuser {
     }
     report.loopClosureM = loopGap(p.poses);
     if (ring) {
-      say("loop gap " + fixed(before * 1e3, 3) + " mm before the pose graph, " +
-          fixed(report.loopClosureM * 1e3, 3) + " mm after");
+      say(optimise ? "loop gap " + fixed(before * 1e3, 3) + " mm before the pose graph, " +
+                         fixed(report.loopClosureM * 1e3, 3) + " mm after"
+                   : "loop gap " + fixed(before * 1e3, 3) + " mm with the table's angles");
     }
     return p;
   }
@@ -265,7 +267,7 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
     }
     report.placement = "given";
     if (options.refine) {
-      placement = fuser.refined(given, false, report);
+      placement = fuser.refined(given, false, true, report);
     } else {
       placement = fuser.empty();
       placement.poses = given;
@@ -282,7 +284,7 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
     const double span = std::abs(*views.back().turntableDeg - *views.front().turntableDeg);
     const double step = span / static_cast<double>(views.size() - 1);
     const bool ring = span + 1.5 * step >= 360.0;
-    placement = fuser.refined(initial, ring, report);
+    placement = fuser.refined(initial, ring, options.refine, report);
   } else {
     report.placement = "sequential";
     if (allAngles) {

@@ -1,5 +1,7 @@
 #include "truth_surface.hpp"
 
+#include <open3d/geometry/KDTreeFlann.h>
+#include <open3d/geometry/PointCloud.h>
 #include <open3d/t/geometry/RaycastingScene.h>
 
 #include <algorithm>
@@ -89,9 +91,27 @@ std::vector<double> distances(const std::vector<Eigen::Vector3d>& points,
 
 std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
                         const open3d::geometry::TriangleMesh& surface, double distanceM) {
-  const auto d = distances(points, surface);
-  return static_cast<std::size_t>(
-      std::ranges::count_if(d, [&](double v) { return v <= distanceM; }));
+  if (points.empty() || surface.triangles_.empty()) {
+    return 0;
+  }
+  // Sampled densely rather than ray-cast: Open3D's closest-point query asserts on the sliver
+  // triangles marching cubes makes. A sample every ~0.2·distance leaves the count within a few
+  // hundredths of a millimetre of exact.
+  const double spacing = 0.2 * distanceM;
+  const auto samples = static_cast<std::size_t>(
+      std::clamp(surface.GetSurfaceArea() / (spacing * spacing), 1e5, 2e7));
+  auto sampled = surface;  // Open3D samples only a mutable mesh
+  const auto dense = sampled.SamplePointsUniformly(samples);
+  const open3d::geometry::KDTreeFlann tree(*dense);
+  std::vector<int> index(1);
+  std::vector<double> distance2(1);
+  std::size_t within = 0;
+  for (const auto& p : points) {
+    if (tree.SearchKNN(p, 1, index, distance2) > 0 && distance2[0] <= distanceM * distanceM) {
+      ++within;
+    }
+  }
+  return within;
 }
 
 DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,

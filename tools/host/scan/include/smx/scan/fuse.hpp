@@ -32,7 +32,11 @@ struct FuseOptions {
   // Mesh pieces with fewer triangles than this share of the largest piece's are removed
   // (model_cleanup.hpp); 0 keeps every piece.
   double minPieceShare = 0.02;
-  bool refine = false;                // refine poses given by the caller too
+  // Refine given poses, and turntable poses, by registration and a pose graph. Off: given poses
+  // are used as they are, and turntable views are placed by their angles about the (calibrated)
+  // axis, their registrations only judging the overlap (decoded depth's small view-dependent
+  // errors would otherwise turn the views off the true axis).
+  bool refine = false;
   double minFitness = 0.3;            // a view registering below this is refused
   double registrationVoxelM = 0.002;  // the clouds registration works on (finest ICP level)
   std::function<void(std::string_view)> progress{};  // one line per step, when set
