@@ -31,7 +31,7 @@ std::string scanResultsMarkdown(const TurntableEvalResult& t, const HandheldEval
                  verdict(t.meanMm <= 0.2)) +
       printfText("| mesh to true surface, 95th percentile | %.3f mm | ≤ 0.6 mm | %s |\n", t.p95Mm,
                  verdict(t.p95Mm <= 0.6)) +
-      printfText("| coverage of the surface the views see | %.1f %% | ≥ 95 %% | %s |\n",
+      printfText("| coverage of the object's surface the views see | %.1f %% | ≥ 95 %% | %s |\n",
                  100.0 * t.coverage, verdict(t.coverage >= 0.95)) +
       printfText(
           "| registration, fusion and meshing after the last view | %.1f s | ≤ 60 s | %s "

@@ -57,11 +57,12 @@ sim::Scene turned(const sim::Scene& scene, double deg) {
   return out;
 }
 
-// The objects standing on the table, at angle 0: the model's frame.
-open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene) {
+// The objects standing on the table, at angle 0: the model's frame. `scannedOnly`: only the
+// meshes among them, the scanned object (a primitive on the table is the platter, a fixture).
+open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene, bool scannedOnly) {
   open3d::geometry::TriangleMesh all;
   for (const auto& object : scene.objects) {
-    if (object.onTurntable) {
+    if (object.onTurntable && (!scannedOnly || std::holds_alternative<sim::Mesh>(object.shape))) {
       all += detail::objectSurface(object);
     }
   }
@@ -137,8 +138,10 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   rig.turntable = algo::TurntableAxis{.axis = {mount.axis.x(), mount.axis.y(), mount.axis.z()},
                                       .point = {mount.pivot.x(), mount.pivot.y(), mount.pivot.z()}};
 
-  open3d::geometry::TriangleMesh truth = trueSurface(scene);
-  const auto sampled = truth.SamplePointsUniformly(kSurfaceSamples);
+  // Distances to everything on the table; coverage of the scanned object.
+  open3d::geometry::TriangleMesh truth = trueSurface(scene, false);
+  open3d::geometry::TriangleMesh scanned = trueSurface(scene, true);
+  const auto sampled = scanned.SamplePointsUniformly(kSurfaceSamples);
   const std::vector<Vec3>& samples = sampled->points_;
   std::vector<char> seen(samples.size(), 0);
 

@@ -28,8 +28,9 @@ struct TurntableEvalResult {
   int fusedViews = 0;
   double meanMm = 0.0;  // fused mesh vertices to the true surface
   double p95Mm = 0.0;
-  // Of the true surface the views can see (visible from a camera and lit by a projector in some
-  // view), the share within 1 mm of the fused mesh.
+  // Of the scanned object's true surface the views can see (visible from a camera and lit by a
+  // projector in some view; the scene's meshes on the table, not its platter), the share within
+  // 1 mm of the fused mesh.
   double coverage = 0.0;
   double loopClosureMm = 0.0;
   double fuseS = 0.0;    // registration, fusion and meshing after the last view
