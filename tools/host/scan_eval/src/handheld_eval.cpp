@@ -70,6 +70,9 @@ HandheldEvalResult runHandheldEval(const HandheldEvalOptions& options) {
   if (options.supersampling > 0) {
     scene.supersampling = options.supersampling;
   }
+  if (options.realism) {
+    detail::addRealism(scene);
+  }
   const sim::Handheld& hand = *scene.handheld;
   const algo::Rig rig = eval::loadExampleRig(options.rigFile);
   auto tracker = scan::Tracker::create(rig);

@@ -55,6 +55,16 @@ std::shared_ptr<open3d::geometry::TriangleMesh> localSurface(const sim::Shape& s
 
 }  // namespace
 
+void addRealism(sim::Scene& scene) {
+  scene.lighting.projectorBlackLevel = 0.01;
+  scene.lighting.projectorGamma = 2.1;
+  scene.lighting.projectorDefocusSigmaPx = 0.6;
+  scene.camera.defocusSigmaPx = 0.4;
+  scene.camera.responseGamma = 1.6;
+  scene.camera.vignetting = 0.2;
+  scene.camera.bayer = "rggb";
+}
+
 open3d::geometry::TriangleMesh objectSurface(const sim::Object& object,
                                              const Eigen::Isometry3d& to) {
   auto mesh = localSurface(object.shape);

@@ -10,6 +10,11 @@
 // The simulator's objects as triangles, and a fused mesh measured against them.
 namespace smx::scan_eval::detail {
 
+// The realism options of the renderer at the middle of the ranges the realism suite draws from
+// (docs/simulator.md): projector black level 1 %, display gamma 2.1, projector and camera
+// defocus 0.6 and 0.4 px, response gamma 1.6, vignetting 20 %, an RGGB Bayer mosaic.
+void addRealism(sim::Scene& scene);
+
 // `object`'s surface, moved by `to` after its pose (world → model frame).
 [[nodiscard]] open3d::geometry::TriangleMesh objectSurface(
     const sim::Object& object, const Eigen::Isometry3d& to = Eigen::Isometry3d::Identity());

@@ -133,6 +133,9 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   if (options.supersampling > 0) {
     scene.supersampling = options.supersampling;
   }
+  if (options.realism) {
+    detail::addRealism(scene);
+  }
   algo::Rig rig = eval::loadExampleRig(options.rigFile);
   const auto& mount = mountOf(scene);
   rig.turntable = algo::TurntableAxis{.axis = {mount.axis.x(), mount.axis.y(), mount.axis.z()},

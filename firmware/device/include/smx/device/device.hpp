@@ -188,12 +188,12 @@ class Device {
   // Turntable: the network thread takes a request (kIdle → kRequested), the capture loop moves
   // (→ kMoving → kDone), the network thread answers (→ kIdle).
   enum class TurnState : std::uint8_t { kIdle, kRequested, kMoving, kDone };
-  std::atomic<TurnState> turnState_ = TurnState::kIdle;
-  std::atomic<std::int32_t> turnSteps_ = 0;
   std::atomic<std::uint64_t> turnConnection_ = 0;  // the host that asked (counters_.connections)
-  hal::HalError turnError_{};                      // written before kDone, read after
-  bool turnFailed_ = false;                        // likewise
   std::atomic<std::int64_t> settledNs_ = 0;        // device clock at the end of the last settle
+  hal::HalError turnError_{};                      // written before kDone, read after
+  std::atomic<std::int32_t> turnSteps_ = 0;
+  std::atomic<TurnState> turnState_ = TurnState::kIdle;
+  bool turnFailed_ = false;  // written before kDone, read after
 
   // Network thread only.
   protocol::StreamParser parser_;

@@ -18,6 +18,7 @@ struct HandheldEvalOptions {
   double voxelM = 0.001;
   int supersampling = 0;
   std::uint64_t seed = 1;
+  bool realism = true;  // the renderer's realism options (addRealism), as real optics have
   std::function<void(const std::string&)> progress{};
 };
 

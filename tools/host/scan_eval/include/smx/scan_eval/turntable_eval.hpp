@@ -18,6 +18,7 @@ struct TurntableEvalOptions {
   double tableRadiusM = 0.25;  // the scan volume round the table's axis
   int supersampling = 0;       // 0: the scene's own
   std::uint64_t seed = 1;
+  bool realism = true;  // the renderer's realism options (addRealism), as real optics have
   std::function<void(const std::string&)> progress{};
 };
 
