@@ -3,11 +3,9 @@
 // `stripemux capture` and the guided calibration capture against a checkerboard scene.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <future>
-#include <memory>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -18,10 +16,9 @@
 #include "device_client.hpp"
 #include "replay_board.hpp"
 #include "sim_calibration.hpp"
+#include "sim_device.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/config/rig_json.hpp"
-#include "smx/device/device.hpp"
-#include "smx/hal/board_hal.hpp"
 #include "smx/net/tcp_client.hpp"
 #include "smx/protocol/messages.hpp"
 #include "smx/protocol/stream_parser.hpp"
@@ -91,60 +88,11 @@ fs::path checkerScene() {
 
 // boards/sim rendering `scene` live with the 1-camera rig (seed 1), on a free loopback port.
 config::Board renderBoard(const std::string& scene) {
-  config::Board board = config::loadBoard(kSource / "boards/sim").value();
-  board.config.sim.scene = scene;
-  board.config.sim.replayDir.clear();
-  board.config.network.port = 0;
-  board.rig = config::loadRig(kRig1).value();
-  board.config.cameras.resize(1);
-  board.config.cameras.front().format.fps = 1000;
-  return board;
+  return test::renderingScene(test::sourceBoard("sim"), scene, config::loadRig(kRig1).value());
 }
 
-struct RunningDevice {
-  explicit RunningDevice(config::Board boardIn) : board(std::move(boardIn)) {
-    auto made = hal::createBoardHal(board.config, board.rig);
-    EXPECT_TRUE(made.has_value()) << made.error();
-    boardHal = std::move(*made);
-    auto dev = device::Device::create(board, boardHal->hal(), {});
-    EXPECT_TRUE(dev.has_value()) << dev.error();
-    device = std::move(*dev);
-    network = std::jthread([this] { device->runNetwork(stopNetwork); });
-  }
-  ~RunningDevice() {
-    stopCapture = true;
-    if (capture.joinable()) {
-      capture.join();
-    }
-    stopNetwork = true;
-  }
-  RunningDevice(const RunningDevice&) = delete;
-  RunningDevice& operator=(const RunningDevice&) = delete;
-
-  void startCapture() {
-    capture = std::jthread([this] { device->runCapture(stopCapture); });
-  }
-  // Serves the next raw capture a host asks for, on this thread.
-  void serveOne() const {
-    const auto deadline = std::chrono::steady_clock::now() + 10s;
-    while (!device->rawCaptureRequested() && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(1ms);
-    }
-    EXPECT_TRUE(device->serveRawCapture()) << "no capture-raw arrived";
-  }
-  [[nodiscard]] std::string address() const {
-    return "127.0.0.1:" + std::to_string(boardHal->hal().link.port());
-  }
-  [[nodiscard]] sim::SimBoardControl& control() const { return *sim::simBoardControl(*boardHal); }
-
-  config::Board board;
-  std::unique_ptr<hal::BoardHal> boardHal;
-  std::unique_ptr<device::Device> device;
-  std::atomic<bool> stopNetwork = false;
-  std::atomic<bool> stopCapture = false;
-  std::jthread network;
-  std::jthread capture;
-};
+// Network loop only: a test serves the raw captures itself or calls startCapture().
+using RunningDevice = test::SimDevice;
 
 // The device's frame for `mask`, with the capture served here so that the simulated camera's
 // frame number (its count of frames delivered) is known.
@@ -152,7 +100,7 @@ host::RawCapture captureServedHere(RunningDevice& running, host::DeviceClient& c
                                    std::uint32_t mask) {
   auto pending =
       std::async(std::launch::async, [&client, mask] { return client.captureRaw(mask, 20s); });
-  running.serveOne();
+  EXPECT_TRUE(running.serveOne()) << "no capture-raw arrived";
   auto capture = pending.get();
   EXPECT_TRUE(capture.has_value()) << capture.error();
   return capture ? std::move(*capture) : host::RawCapture{};
@@ -209,12 +157,12 @@ TEST(CaptureSim, ServingARawCaptureAllocatesNothing) {
 
   auto pending = std::async(std::launch::async, [&] { return client->captureRaw(0b01U, 20s); });
   const auto deadline = std::chrono::steady_clock::now() + 10s;
-  while (!running.device->rawCaptureRequested() && std::chrono::steady_clock::now() < deadline) {
+  while (!running.device().rawCaptureRequested() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(1ms);
   }
   // The host waits for the bands now, so the counter sees the device alone.
   const test::AllocationCounter allocations;
-  const bool served = running.device->serveRawCapture();
+  const bool served = running.device().serveRawCapture();
   const std::uint64_t heapCalls = allocations.allocations();
   EXPECT_TRUE(served);
   EXPECT_EQ(heapCalls, 0U) << "serving a raw capture allocated";
@@ -274,7 +222,7 @@ TEST(CaptureSim, TheDeviceRefusesWhatItCannotDoWithAnError) {
             std::string::npos);
   EXPECT_NE(std::string(protocol::decodeError(replies[2].payload)->text).find("does not know"),
             std::string::npos);
-  EXPECT_FALSE(running.device->rawCaptureRequested());
+  EXPECT_FALSE(running.device().rawCaptureRequested());
 }
 
 // Given a camera that times out during a raw capture, the host is told which camera and why,
@@ -285,15 +233,15 @@ TEST(CaptureSim, ACameraFailingDuringARawCaptureIsReportedByName) {
   ASSERT_TRUE(client.has_value()) << client.error();
   running.control().injectTimeouts(0, 1);
   auto pending = std::async(std::launch::async, [&] { return client->captureRaw(0b10U, 20s); });
-  running.serveOne();
+  EXPECT_TRUE(running.serveOne()) << "no capture-raw arrived";
   const auto failed = pending.get();
   ASSERT_FALSE(failed.has_value());
   EXPECT_NE(failed.error().find("capture-raw: cam0: no frame from the simulated camera in time "
                                 "(timeout)"),
             std::string::npos)
       << failed.error();
-  EXPECT_EQ(running.device->counters().captureErrors, 1U);
-  EXPECT_EQ(running.boardHal->hal().trigger.active(), 0U) << "lines left on";
+  EXPECT_EQ(running.device().counters().captureErrors, 1U);
+  EXPECT_EQ(running.hal().trigger.active(), 0U) << "lines left on";
   const auto next = captureServedHere(running, *client, 0b01U);
   EXPECT_EQ(next.images.size(), 1U);
 }
@@ -310,8 +258,8 @@ TEST(CaptureSim, CaptureCommandWritesTheCalibrationNames) {
   for (const char* name : {"cam0.png", "proj0.cam0.png"}) {
     const auto image = sim::readPngRgb8(out / name);
     ASSERT_TRUE(image.has_value()) << name << ": " << image.error();
-    EXPECT_EQ(image->width, running.board.rig.cameras[0].width);
-    EXPECT_EQ(image->height, running.board.rig.cameras[0].height);
+    EXPECT_EQ(image->width, running.board().rig.cameras[0].width);
+    EXPECT_EQ(image->height, running.board().rig.cameras[0].height);
   }
   EXPECT_FALSE(fs::exists(out / "proj1.cam0.png"));
 
@@ -357,7 +305,7 @@ TEST(CaptureSim, GuidedCaptureWritesAPoseAndRefusesOneTooSimilar) {
   std::ostringstream out;
   std::ostringstream err;
   const auto summary =
-      host::captureCalibrationSet(*client, running.board.rig, guideOptions(1), dir, {out, err});
+      host::captureCalibrationSet(*client, running.board().rig, guideOptions(1), dir, {out, err});
   ASSERT_TRUE(summary.has_value()) << summary.error() << "\n" << out.str();
   ASSERT_EQ(summary->poses.size(), 1U);
   EXPECT_EQ(summary->poses[0].cornersPerCamera, std::vector<int>{28});
@@ -383,7 +331,7 @@ TEST(CaptureSim, GuidedCaptureWritesAPoseAndRefusesOneTooSimilar) {
   fs::create_directories(second);
   fs::copy_file(dir / "target.json", second / "target.json");
   const auto refused =
-      host::captureCalibrationSet(*client, running.board.rig, options, second, {again, err});
+      host::captureCalibrationSet(*client, running.board().rig, options, second, {again, err});
   ASSERT_FALSE(refused.has_value());
   EXPECT_NE(refused.error().find("pose01: "), std::string::npos) << refused.error();
   EXPECT_NE(refused.error().find("too similar to pose00"), std::string::npos) << refused.error();
@@ -416,21 +364,14 @@ TEST(CaptureSim, GuidedCaptureStartsAPoseOverWhenTheBoardMoved) {
   config::Board board = renderBoard("plane");
   board.config.sim.scene.clear();
   board.config.sim.replayDir = replay;
-  RunningDevice running(std::move(board));
-  const std::jthread rawOnly([&](const std::stop_token& stop) {
-    while (!stop.stop_requested()) {
-      if (!running.device->serveRawCapture()) {
-        std::this_thread::sleep_for(1ms);
-      }
-    }
-  });
+  RunningDevice running(std::move(board), {.loops = test::SimLoops::kServe});
   auto client = host::DeviceClient::connect(running.address(), 3000ms);
   ASSERT_TRUE(client.has_value()) << client.error();
   const fs::path dir = scratch("moved");
   std::ostringstream out;
   std::ostringstream err;
   const auto summary =
-      host::captureCalibrationSet(*client, running.board.rig, guideOptions(1), dir, {out, err});
+      host::captureCalibrationSet(*client, running.board().rig, guideOptions(1), dir, {out, err});
   ASSERT_TRUE(summary.has_value()) << summary.error() << "\n" << out.str();
   EXPECT_NE(out.str().find("pose00: the board moved while the projector frames were taken"),
             std::string::npos)
@@ -453,7 +394,7 @@ TEST(CaptureSim, GuidedCaptureSaysWhenTheTargetIsNeverFound) {
   options.poseTimeout = 2s;
   std::ostringstream out;
   std::ostringstream err;
-  const auto result = host::captureCalibrationSet(*client, running.board.rig, options,
+  const auto result = host::captureCalibrationSet(*client, running.board().rig, options,
                                                   scratch("never"), {out, err});
   ASSERT_FALSE(result.has_value());
   EXPECT_NE(result.error().find("pose00: "), std::string::npos) << result.error();

@@ -4,29 +4,23 @@
 // and the calibration must find the true rig from the announced one.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli.hpp"
-#include "smx/config/board_json.hpp"
+#include "sim_device.hpp"
 #include "smx/config/rig_json.hpp"
-#include "smx/device/device.hpp"
-#include "smx/hal/board_hal.hpp"
 #include "source_dir.hpp"
 
 namespace smx {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace std::chrono_literals;
 using Json = nlohmann::json;
 
 const fs::path kSource = test::sourceDir();
@@ -53,52 +47,11 @@ fs::path scratch(const std::string& name) {
 // boards/sim rendering `scene` with `rendered`, announcing `announced`, on a free loopback port.
 // Only raw captures are served (no range stream), so the simulated camera's frame k is the k-th
 // raw capture: a scene's pose_sequence advances one frame per capture.
-class SimDevice {
+class RenderingDevice : public test::SimDevice {
  public:
-  SimDevice(const std::string& scene, const algo::Rig& rendered, const algo::Rig& announced) {
-    board_ = config::loadBoard(kSource / "boards/sim").value();
-    board_.config.sim.scene = scene;
-    board_.config.sim.replayDir.clear();
-    board_.config.network.port = 0;
-    board_.config.cameras.resize(announced.cameras.size());
-    for (auto& camera : board_.config.cameras) {
-      camera.format.fps = 1000;
-    }
-    board_.rig = announced;
-    auto made = hal::createBoardHal(board_.config, rendered);
-    EXPECT_TRUE(made.has_value()) << made.error();
-    boardHal_ = std::move(*made);
-    auto dev = device::Device::create(board_, boardHal_->hal(), {});
-    EXPECT_TRUE(dev.has_value()) << dev.error();
-    device_ = std::move(*dev);
-    network_ = std::jthread([this] { device_->runNetwork(stopNetwork_); });
-    raw_ = std::jthread([this](const std::stop_token& stop) {
-      while (!stop.stop_requested()) {
-        if (!device_->serveRawCapture()) {
-          std::this_thread::sleep_for(1ms);
-        }
-      }
-    });
-  }
-  ~SimDevice() {
-    raw_.request_stop();
-    raw_.join();
-    stopNetwork_ = true;
-  }
-  SimDevice(const SimDevice&) = delete;
-  SimDevice& operator=(const SimDevice&) = delete;
-
-  [[nodiscard]] std::string address() const {
-    return "127.0.0.1:" + std::to_string(boardHal_->hal().link.port());
-  }
-
- private:
-  config::Board board_;
-  std::unique_ptr<hal::BoardHal> boardHal_;
-  std::unique_ptr<device::Device> device_;
-  std::atomic<bool> stopNetwork_ = false;
-  std::jthread network_;
-  std::jthread raw_;
+  RenderingDevice(const std::string& scene, const algo::Rig& rendered, const algo::Rig& announced)
+      : test::SimDevice(test::renderingScene(test::sourceBoard("sim"), scene, announced),
+                        {.loops = test::SimLoops::kServe, .renderedRig = rendered}) {}
 };
 
 algo::Rig loadRig(const fs::path& file) {
@@ -139,14 +92,14 @@ algo::Rig withProjectorMoved(algo::Rig rig, std::size_t projector, std::size_t a
 TEST(DeviceCommandsSim, CheckOnADeviceFlagsAProjectorItsRigMisplaces) {
   const algo::Rig truth = loadRig(kSource / "boards/sim/rig_2proj_2cam.json");
   {
-    const SimDevice device("plane", truth, truth);
+    const RenderingDevice device("plane", truth, truth);
     const fs::path report = scratch("check_good");
     const auto run = cli({"check", "--device", device.address(), "--report", report.string()});
     EXPECT_EQ(run.code, host::kExitOk) << run.err << run.out;
     EXPECT_NE(run.out.find("good: all 2 projectors agree"), std::string::npos) << run.out;
     EXPECT_TRUE(fs::exists(report / "check.json"));
   }
-  const SimDevice device("plane", truth, withProjectorMoved(truth, 0, 0, 0.002));
+  const RenderingDevice device("plane", truth, withProjectorMoved(truth, 0, 0, 0.002));
   const auto run = cli({"check", "--device", device.address(), "--json"});
   EXPECT_EQ(run.code, 4) << run.err << run.out;
   const auto json = Json::parse(run.out, nullptr, false);
@@ -229,7 +182,7 @@ TEST(DeviceCommandsSim, GuidedCalibrateOnADeviceFindsTheRenderedRig) {
   const std::string corners = std::to_string(target["inner_corners"][0].get<int>()) + "x" +
                               std::to_string(target["inner_corners"][1].get<int>());
 
-  const SimDevice device(quickCalibrationScene(sim, 6, 1).string(), truth, announced);
+  const RenderingDevice device(quickCalibrationScene(sim, 6, 1).string(), truth, announced);
   const fs::path out = scratch("calibrated");
   const auto run =
       cli({"calibrate", "--device", device.address(), "--poses", "6", "--target", corners,

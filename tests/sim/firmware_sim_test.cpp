@@ -15,6 +15,7 @@
 #include "cli.hpp"
 #include "device_client.hpp"
 #include "replay_board.hpp"
+#include "sim_device.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/config/rig_json.hpp"
 #include "smx/device/device.hpp"
@@ -52,42 +53,10 @@ config::Board simBoard(int cameras) {
 }
 
 // A device on the simulated board with its network loop running.
-struct RunningDevice {
+class RunningDevice : public test::SimDevice {
+ public:
   explicit RunningDevice(int cameras, const device::DeviceOptions& options = {})
-      : board(simBoard(cameras)) {
-    auto made = hal::createBoardHal(board.config, board.rig);
-    EXPECT_TRUE(made.has_value()) << made.error();
-    boardHal = std::move(*made);
-    auto dev = device::Device::create(board, boardHal->hal(), options);
-    EXPECT_TRUE(dev.has_value()) << dev.error();
-    device = std::move(*dev);
-    network = std::jthread([this] { device->runNetwork(stopNetwork); });
-  }
-  ~RunningDevice() {
-    stopCapture = true;
-    if (capture.joinable()) {
-      capture.join();
-    }
-    stopNetwork = true;
-  }
-  RunningDevice(const RunningDevice&) = delete;
-  RunningDevice& operator=(const RunningDevice&) = delete;
-
-  void startCapture() {
-    capture = std::jthread([this] { device->runCapture(stopCapture); });
-  }
-  [[nodiscard]] std::string address() const {
-    return "127.0.0.1:" + std::to_string(boardHal->hal().link.port());
-  }
-  [[nodiscard]] sim::SimBoardControl& control() const { return *sim::simBoardControl(*boardHal); }
-
-  config::Board board;
-  std::unique_ptr<hal::BoardHal> boardHal;
-  std::unique_ptr<device::Device> device;
-  std::atomic<bool> stopNetwork = false;
-  std::atomic<bool> stopCapture = false;
-  std::jthread network;
-  std::jthread capture;
+      : test::SimDevice(simBoard(cameras), {.device = options}) {}
 };
 
 device::DeviceOptions idleTimeout(std::int64_t ns) {
@@ -174,20 +143,20 @@ void expectHundredStreamedFramesAllocateNothing(bool confidence) {
   host.helloAndStart(confidence);
   host.startDraining();
   // Warm up: the host is accepted and streaming, every buffer has been touched.
-  while (!running.device->streaming()) {
+  while (!running.device().streaming()) {
     std::this_thread::sleep_for(1ms);
   }
   for (int i = 0; i < 3; ++i) {
-    ASSERT_TRUE(running.device->captureOnce().has_value());
+    ASSERT_TRUE(running.device().captureOnce().has_value());
   }
-  const auto& counters = running.device->counters();
+  const auto& counters = running.device().counters();
   const std::uint64_t decodedBefore = counters.framesDecoded;
   const std::uint64_t queuedBefore = counters.framesQueued;
 
   const test::AllocationCounter allocations;
   int failed = 0;
   for (int i = 0; i < 100; ++i) {
-    failed += running.device->captureOnce().has_value() ? 0 : 1;
+    failed += running.device().captureOnce().has_value() ? 0 : 1;
   }
   const std::uint64_t heapCalls = allocations.allocations();
 
@@ -339,7 +308,7 @@ TEST_F(FirmwareSim, AHostCanLeaveAndAnotherConnect) {
     EXPECT_EQ(received, 2) << "round " << round;
     client->close();  // leaves mid-stream, without stop
   }
-  EXPECT_EQ(running.device->counters().connections, 2U);
+  EXPECT_EQ(running.device().counters().connections, 2U);
 }
 
 TEST_F(FirmwareSim, ASlowHostMakesTheDeviceDropFramesButNotStopCapturing) {
@@ -348,24 +317,24 @@ TEST_F(FirmwareSim, ASlowHostMakesTheDeviceDropFramesButNotStopCapturing) {
   host.helloAndStart();
   host.pause(true);
   host.startDraining();
-  while (!running.device->streaming()) {
+  while (!running.device().streaming()) {
     std::this_thread::sleep_for(1ms);
   }
   // The host reads nothing while the device captures 25 frames: each capture still completes.
   constexpr int kCaptures = 25;
   for (int i = 0; i < kCaptures; ++i) {
-    ASSERT_TRUE(running.device->captureOnce().has_value()) << "capture " << i;
+    ASSERT_TRUE(running.device().captureOnce().has_value()) << "capture " << i;
   }
-  const auto& counters = running.device->counters();
+  const auto& counters = running.device().counters();
   EXPECT_EQ(counters.framesDecoded, std::uint64_t{kCaptures});
   EXPECT_EQ(counters.captureErrors, 0U);
   // What is not dropped fits in the queue (4 slots) and the socket buffers (a few frames).
-  EXPECT_GE(running.device->framesDropped(), std::uint64_t{kCaptures - 12});
+  EXPECT_GE(running.device().framesDropped(), std::uint64_t{kCaptures - 12});
   // Once the host reads again, frames flow.
   const std::uint64_t sentBefore = counters.framesSent;
   host.pause(false);
   for (int i = 0; i < 3; ++i) {
-    ASSERT_TRUE(running.device->captureOnce().has_value());
+    ASSERT_TRUE(running.device().captureOnce().has_value());
   }
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (counters.framesSent <= sentBefore && std::chrono::steady_clock::now() < deadline) {
@@ -377,7 +346,7 @@ TEST_F(FirmwareSim, ASlowHostMakesTheDeviceDropFramesButNotStopCapturing) {
 TEST_F(FirmwareSim, TriggerLinesAreActiveDuringEveryExposure) {
   RunningDevice running(2);
   for (int i = 0; i < 3; ++i) {
-    ASSERT_TRUE(running.device->captureOnce().has_value());
+    ASSERT_TRUE(running.device().captureOnce().has_value());
   }
   const auto edges = running.control().triggerEdges();
   ASSERT_EQ(edges.size(), 6U);  // on and off per capture
@@ -424,18 +393,18 @@ TEST_F(FirmwareSim, RangeCapturesLightOnlyTheChosenProjectors) {
 TEST_F(FirmwareSim, CameraFaultsAreCountedAndCaptureRecovers) {
   RunningDevice running(1);
   running.control().injectTimeouts(0, 2);
-  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kTimeout);
-  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kTimeout);
-  EXPECT_TRUE(running.device->captureOnce().has_value());
+  EXPECT_EQ(running.device().captureOnce().error().code, hal::HalErrc::kTimeout);
+  EXPECT_EQ(running.device().captureOnce().error().code, hal::HalErrc::kTimeout);
+  EXPECT_TRUE(running.device().captureOnce().has_value());
 
   running.control().disconnect(0);
-  EXPECT_EQ(running.device->captureOnce().error().code, hal::HalErrc::kDisconnected);
-  EXPECT_FALSE(running.boardHal->hal().cameras[0]->recover().has_value());
+  EXPECT_EQ(running.device().captureOnce().error().code, hal::HalErrc::kDisconnected);
+  EXPECT_FALSE(running.hal().cameras[0]->recover().has_value());
   running.control().reconnect(0);
-  EXPECT_TRUE(running.boardHal->hal().cameras[0]->recover().has_value());
-  EXPECT_TRUE(running.device->captureOnce().has_value());
-  EXPECT_EQ(running.device->counters().captureErrors, 3U);
-  EXPECT_EQ(running.device->counters().framesDecoded, 2U);
+  EXPECT_TRUE(running.hal().cameras[0]->recover().has_value());
+  EXPECT_TRUE(running.device().captureOnce().has_value());
+  EXPECT_EQ(running.device().counters().captureErrors, 3U);
+  EXPECT_EQ(running.device().counters().framesDecoded, 2U);
 }
 
 TEST_F(FirmwareSim, GarbageFromTheHostIsCountedAndTheConnectionStaysUsable) {
@@ -468,7 +437,7 @@ TEST_F(FirmwareSim, GarbageFromTheHostIsCountedAndTheConnectionStaysUsable) {
   ASSERT_EQ(replies.size(), 2U);
   EXPECT_EQ(replies[0], protocol::MessageType::kError);  // "this device speaks version 1"
   EXPECT_EQ(replies[1], protocol::MessageType::kCapabilities);
-  EXPECT_GE(running.device->counters().protocolErrors, 2U);  // the garbage and the v9 message
+  EXPECT_GE(running.device().counters().protocolErrors, 2U);  // the garbage and the v9 message
 }
 
 // Given a host streaming from the device, when a second host connects, then the second is told
@@ -500,7 +469,7 @@ TEST_F(FirmwareSim, ASecondHostIsToldTheDeviceIsBusyAndTheFirstKeepsStreaming) {
   EXPECT_NE(second.error().find("held by 127.0.0.1:"), std::string::npos) << second.error();
 
   EXPECT_EQ(receive(2), 2) << "the first host lost its stream";
-  EXPECT_EQ(running.device->counters().connections, 1U);
+  EXPECT_EQ(running.device().counters().connections, 1U);
 }
 
 // Given a device with a short idle timeout, when a host says hello and then nothing, then the
@@ -519,7 +488,7 @@ TEST_F(FirmwareSim, AHostSilentWhileNotStreamingIsDroppedAfterTheIdleTimeout) {
   }
   ASSERT_TRUE(closed.has_value()) << "a silent host still holds the device after 5 s";
   EXPECT_GE(std::chrono::steady_clock::now() - start, 300ms);
-  EXPECT_EQ(running.device->counters().idleDisconnects, 1U);
+  EXPECT_EQ(running.device().counters().idleDisconnects, 1U);
 
   auto next = host::DeviceClient::connect(running.address(), 3000ms);
   EXPECT_TRUE(next.has_value()) << next.error();
@@ -537,18 +506,18 @@ TEST_F(FirmwareSim, AStreamingHostIsKeptWhileItReadsAndDroppedWhenItStops) {
   std::this_thread::sleep_for(3s);
   const std::uint64_t bytesBefore = host.bytes();
   EXPECT_GT(bytesBefore, 0U);
-  EXPECT_EQ(running.device->counters().idleDisconnects, 0U);
+  EXPECT_EQ(running.device().counters().idleDisconnects, 0U);
 
   // The device stalls once the host's receive buffer and its own send buffer are full, which
   // takes as many frames as they hold: seconds at the optimised build's frame rate, tens of
   // seconds under the sanitisers on a loaded machine. The bound is for a hung test only.
   host.pause(true);
   const auto deadline = std::chrono::steady_clock::now() + 90s;
-  while (running.device->counters().idleDisconnects == 0 &&
+  while (running.device().counters().idleDisconnects == 0 &&
          std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(10ms);
   }
-  EXPECT_EQ(running.device->counters().idleDisconnects, 1U)
+  EXPECT_EQ(running.device().counters().idleDisconnects, 1U)
       << "a host that reads nothing still holds the device after 90 s";
   host.pause(false);
   EXPECT_TRUE(host.closedByDevice(5s));
@@ -564,24 +533,24 @@ TEST_F(FirmwareSim, StatisticsCountTheHostsOwnConnection) {
     first.helloAndStart();
     std::array<std::byte, 64> out{};
     first.send(protocol::encodeEmpty(protocol::MessageType::kCapabilities, out));  // not for it
-    while (!running.device->streaming()) {
+    while (!running.device().streaming()) {
       std::this_thread::sleep_for(1ms);
     }
     for (int i = 0; i < 25; ++i) {  // the host reads nothing: frames are dropped
-      ASSERT_TRUE(running.device->captureOnce().has_value());
+      ASSERT_TRUE(running.device().captureOnce().has_value());
     }
   }
-  ASSERT_GT(running.device->framesDropped(), 0U);
-  ASSERT_GT(running.device->counters().protocolErrors, 0U);
+  ASSERT_GT(running.device().framesDropped(), 0U);
+  ASSERT_GT(running.device().counters().protocolErrors, 0U);
 
   auto second = host::DeviceClient::connect(running.address(), 3000ms);
   ASSERT_TRUE(second.has_value()) << second.error();
   ASSERT_TRUE(second->startStream(protocol::Compression::kRvl).has_value());
-  while (!running.device->streaming()) {
+  while (!running.device().streaming()) {
     std::this_thread::sleep_for(1ms);
   }
   for (int i = 0; i < 3; ++i) {
-    ASSERT_TRUE(running.device->captureOnce().has_value());
+    ASSERT_TRUE(running.device().captureOnce().has_value());
   }
   int received = 0;
   std::optional<protocol::Statistics> stats;

@@ -4,25 +4,20 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli.hpp"
+#include "sim_device.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/config/scene_json.hpp"
-#include "smx/device/device.hpp"
-#include "smx/hal/board_hal.hpp"
 #include "smx/sim/handheld.hpp"
 #include "smx/sim/named_scenes.hpp"
-#include "source_dir.hpp"
 
 namespace smx {
 namespace {
@@ -32,48 +27,23 @@ using Json = nlohmann::json;
 
 // A board folder on a free loopback port, its capture and network loops running (as stripemuxd
 // runs them), cam0 only: half the rendering, and the scan's placement does not need cam1.
-class SimBoardDevice {
- public:
-  explicit SimBoardDevice(const std::string& board) {
-    board_ = config::loadBoard(test::sourceDir() / "boards" / board).value();
-    board_.config.network.port = 0;
-    board_.config.cameras.resize(1);
-    board_.rig.cameras.resize(1);
-    auto made = hal::createBoardHal(board_.config, board_.rig);
-    EXPECT_TRUE(made.has_value()) << made.error();
-    boardHal_ = std::move(*made);
-    auto dev = device::Device::create(board_, boardHal_->hal(), {});
-    EXPECT_TRUE(dev.has_value()) << dev.error();
-    device_ = std::move(*dev);
-    network_ = std::jthread([this] { device_->runNetwork(stopNetwork_); });
-    capture_ = std::jthread([this] { device_->runCapture(stopCapture_); });
-  }
-  ~SimBoardDevice() {
-    stopCapture_ = true;
-    capture_.join();
-    stopNetwork_ = true;
-  }
-  SimBoardDevice(const SimBoardDevice&) = delete;
-  SimBoardDevice& operator=(const SimBoardDevice&) = delete;
+config::Board cam0Board(const std::string& folder) {
+  config::Board board = test::sourceBoard(folder);
+  board.config.cameras.resize(1);
+  board.rig.cameras.resize(1);
+  return board;
+}
 
-  [[nodiscard]] std::string address() const {
-    return "127.0.0.1:" + std::to_string(boardHal_->hal().link.port());
-  }
-  [[nodiscard]] const config::Board& board() const { return board_; }
+class SimBoardDevice : public test::SimDevice {
+ public:
+  explicit SimBoardDevice(const std::string& folder)
+      : test::SimDevice(cam0Board(folder), {.loops = test::SimLoops::kCapture}) {}
+
   [[nodiscard]] sim::Scene scene() const {
-    auto scene = config::loadScene(sim::resolveScene(board_.config.sim.scene).value());
+    auto scene = config::loadScene(sim::resolveScene(board().config.sim.scene).value());
     EXPECT_TRUE(scene.has_value());
     return scene.value_or(sim::Scene{});
   }
-
- private:
-  config::Board board_;
-  std::unique_ptr<hal::BoardHal> boardHal_;
-  std::unique_ptr<device::Device> device_;
-  std::atomic<bool> stopNetwork_ = false;
-  std::atomic<bool> stopCapture_ = false;
-  std::jthread network_;
-  std::jthread capture_;
 };
 
 fs::path scratch(const std::string& name) {

@@ -4,75 +4,41 @@
 // device.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <memory>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 #include "cli.hpp"
 #include "device_client.hpp"
+#include "sim_device.hpp"
 #include "smx/config/board_json.hpp"
 #include "smx/config/scene_json.hpp"
-#include "smx/device/device.hpp"
-#include "smx/hal/board_hal.hpp"
 #include "smx/sim/named_scenes.hpp"
 #include "smx/sim/renderer.hpp"
-#include "source_dir.hpp"
 
 namespace smx {
 namespace {
 
-namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-const fs::path kBoard = smx::test::sourceDir() / "boards" / "sim-turntable";
 
 // The turntable board on a free loopback port, its capture and network loops running; cam0 only
 // (half the rendering).
-class TurntableDevice {
+config::Board turntableBoard(bool withTable = true) {
+  config::Board board = test::sourceBoard("sim-turntable");
+  board.config.cameras.resize(1);
+  board.rig.cameras.resize(1);
+  if (!withTable) {
+    board.config.turntable.reset();
+  }
+  return board;
+}
+
+class TurntableDevice : public test::SimDevice {
  public:
-  explicit TurntableDevice(bool withTable = true) {
-    board_ = config::loadBoard(kBoard).value();
-    board_.config.network.port = 0;
-    board_.config.cameras.resize(1);
-    board_.rig.cameras.resize(1);
-    if (!withTable) {
-      board_.config.turntable.reset();
-    }
-    auto made = hal::createBoardHal(board_.config, board_.rig);
-    EXPECT_TRUE(made.has_value()) << made.error();
-    boardHal_ = std::move(*made);
-    auto dev = device::Device::create(board_, boardHal_->hal(), {});
-    EXPECT_TRUE(dev.has_value()) << dev.error();
-    device_ = std::move(*dev);
-    network_ = std::jthread([this] { device_->runNetwork(stopNetwork_); });
-    capture_ = std::jthread([this] { device_->runCapture(stopCapture_); });
-  }
-  ~TurntableDevice() {
-    stopCapture_ = true;
-    capture_.join();
-    stopNetwork_ = true;
-  }
-  TurntableDevice(const TurntableDevice&) = delete;
-  TurntableDevice& operator=(const TurntableDevice&) = delete;
-
-  [[nodiscard]] std::string address() const {
-    return "127.0.0.1:" + std::to_string(boardHal_->hal().link.port());
-  }
-  [[nodiscard]] const config::Board& board() const { return board_; }
-
- private:
-  config::Board board_;
-  std::unique_ptr<hal::BoardHal> boardHal_;
-  std::unique_ptr<device::Device> device_;
-  std::atomic<bool> stopNetwork_ = false;
-  std::atomic<bool> stopCapture_ = false;
-  std::jthread network_;
-  std::jthread capture_;
+  explicit TurntableDevice(bool withTable = true)
+      : test::SimDevice(turntableBoard(withTable), {.loops = test::SimLoops::kCapture}) {}
 };
 
 // The first range frame of cam0 the stream delivers.

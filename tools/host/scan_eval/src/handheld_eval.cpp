@@ -7,7 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "smx/eval/frame_eval.hpp"
+#include "decoded_range.hpp"
 #include "smx/eval/sim_frame.hpp"
 #include "smx/scan/fuse.hpp"
 #include "smx/scan/tracker.hpp"
@@ -21,19 +21,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
-scan::CameraRange decoded(const eval::SimFrame& frame, int camera) {
-  const auto run = eval::runPipeline(frame, camera);
-  const algo::ConstDepthPlane merged = run->pipeline->merged();
-  scan::CameraRange range;
-  range.width = merged.width();
-  range.height = merged.height();
-  for (int y = 0; y < range.height; ++y) {
-    const auto row = merged.row(y);
-    range.depth.insert(range.depth.end(), row.begin(), row.end());
-  }
-  return range;
-}
 
 struct PoseError {
   double mm = 0.0;
@@ -98,7 +85,7 @@ HandheldEvalResult runHandheldEval(const HandheldEvalOptions& options) {
       request.camera = c;
       request.frame = f;
       request.seed = options.seed;
-      view.cameras.push_back(decoded(eval::renderSimFrame(rig, scene, request), c));
+      view.cameras.push_back(detail::decoded(eval::renderSimFrame(rig, scene, request), c));
     }
     const auto start = Clock::now();
     const scan::TrackResult tracked = tracker->track(view);

@@ -10,8 +10,9 @@
 #include <stdexcept>
 #include <variant>
 
+#include "decoded_range.hpp"
 #include "smx/algo/lens.hpp"
-#include "smx/eval/frame_eval.hpp"
+#include "smx/algo/range_image.hpp"
 #include "smx/eval/sim_frame.hpp"
 #include "smx/scan/fuse.hpp"
 #include "smx/text/printf_text.hpp"
@@ -70,21 +71,6 @@ open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene, bool scanned
     throw std::runtime_error("no object stands on the scene's turntable");
   }
   return all;
-}
-
-scan::CameraRange decoded(const eval::SimFrame& frame, int camera) {
-  const auto run = eval::runPipeline(frame, camera);
-  const algo::ConstDepthPlane merged = run->pipeline->merged();
-  scan::CameraRange range;
-  range.width = merged.width();
-  range.height = merged.height();
-  range.depth.reserve(static_cast<std::size_t>(range.width) *
-                      static_cast<std::size_t>(range.height));
-  for (int y = 0; y < range.height; ++y) {
-    const auto row = merged.row(y);
-    range.depth.insert(range.depth.end(), row.begin(), row.end());
-  }
-  return range;
 }
 
 // Marks the samples (model frame) that camera `camera` sees lit in `frame`, rendered with the
@@ -166,7 +152,7 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
       request.camera = c;
       request.seed = options.seed + static_cast<std::uint64_t>(k);
       const eval::SimFrame frame = eval::renderSimFrame(rig, at, request);
-      view.cameras.push_back(decoded(frame, c));
+      view.cameras.push_back(detail::decoded(frame, c));
       markVisible(frame, c, scene, deg, samples, seen);
     }
     views.push_back(std::move(view));
