@@ -31,7 +31,8 @@ config::Board renderingScene(config::Board board, const std::string& scene, cons
   return board;
 }
 
-SimDevice::SimDevice(config::Board board, SimDeviceOptions options) : board_(std::move(board)) {
+SimDevice::SimDevice(config::Board board, const SimDeviceOptions& options)
+    : board_(std::move(board)) {
   auto made = hal::createBoardHal(board_.config, options.renderedRig.value_or(board_.rig));
   if (!made) {
     throw std::runtime_error("simulated board: " + made.error());

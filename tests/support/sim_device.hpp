@@ -45,7 +45,7 @@ class SimDevice {
  public:
   // Creates the HAL and the Device and starts the loops. Throws std::runtime_error naming what
   // failed.
-  explicit SimDevice(config::Board board, SimDeviceOptions options = {});
+  explicit SimDevice(config::Board board, const SimDeviceOptions& options = {});
   // Stops the loops and joins them, the capture loop first.
   ~SimDevice();
   SimDevice(const SimDevice&) = delete;

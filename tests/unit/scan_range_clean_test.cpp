@@ -72,8 +72,7 @@ TEST(RangeClean, PixelsWithinTwoOfAHoleGoThoseBeyondStay) {
   RangeView view = tiltedPlane(20);
   for (int y = 50; y < 60; ++y) {
     for (int x = 70; x < 80; ++x) {
-      view.cameras[0].depth[static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)] =
-          0;
+      view.cameras[0].depth[static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)] = 0;
     }
   }
   cleanForFusion(view, pinholeRig());

@@ -209,10 +209,12 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
   FuseFolderOptions fuse = opts.fuse;
   fuse.dir = opts.out.string();
   fuse.out = opts.out.string();
-  fuse.tracking = {
-      {"captures", tally->captures}, {"fused", tally->fused},
-      {"lost", tally->lost},         {"relocalised", tally->relocalised},
-      {"track_ms_mean", trackMs},    {"device_frames_dropped", tally->device.framesDropped}};
+  fuse.tracking = TrackingSummary{.captures = tally->captures,
+                                  .fused = tally->fused,
+                                  .lost = tally->lost,
+                                  .relocalised = tally->relocalised,
+                                  .trackMsMean = trackMs,
+                                  .deviceFramesDropped = tally->device.framesDropped};
   return runFuseFolder(fuse, io, "stripemux scan");
 }
 

@@ -73,8 +73,13 @@ Json reportJson(const scan::FuseReport& report, const scan::FuseResult* result,
   doc["seconds"] = {{"registration", report.registrationS},
                     {"fusion", report.fusionS},
                     {"meshing", report.meshingS}};
-  if (!opts.tracking.is_null()) {
-    doc["tracking"] = opts.tracking;
+  if (const auto& t = opts.tracking) {
+    doc["tracking"] = {{"captures", t->captures},
+                       {"fused", t->fused},
+                       {"lost", t->lost},
+                       {"relocalised", t->relocalised},
+                       {"track_ms_mean", t->trackMsMean},
+                       {"device_frames_dropped", t->deviceFramesDropped}};
   }
   return doc;
 }
@@ -86,7 +91,7 @@ std::optional<std::string> optionsProblem(const FuseFolderOptions& opts) {
   if (!std::isfinite(opts.holeMaxMm) || opts.holeMaxMm < 0 || opts.holeMaxMm > 1000) {
     return "--hole-max must be 0 to 1000 mm";
   }
-  if (!(opts.minFitness > 0 && opts.minFitness < 1)) {
+  if (opts.minFitness <= 0 || opts.minFitness >= 1 || std::isnan(opts.minFitness)) {
     return "--min-fitness must be between 0 and 1";
   }
   if (opts.axis.empty() != opts.axisPoint.empty()) {

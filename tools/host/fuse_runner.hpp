@@ -1,7 +1,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -11,6 +12,16 @@
 // Registration, fusion and meshing of a views folder into the scan's outputs
 // (docs/scanning.md): what `stripemux fuse` does, and `stripemux scan` after its captures.
 namespace smx::host {
+
+// A hand-held scan's tracking, for report.json's "tracking".
+struct TrackingSummary {
+  int captures = 0;
+  int fused = 0;
+  int lost = 0;
+  int relocalised = 0;
+  double trackMsMean = 0.0;
+  std::uint64_t deviceFramesDropped = 0;  // frames the host was too slow for
+};
 
 struct FuseFolderOptions {
   std::string dir;
@@ -23,7 +34,7 @@ struct FuseFolderOptions {
   bool refine = false;
   double minFitness = 0.3;
   double tableRadiusMm = 250.0;
-  nlohmann::json tracking{};  // a hand-held scan's tracking figures, report.json's "tracking"
+  std::optional<TrackingSummary> tracking{};
 };
 
 // The options fuse and scan share: --voxel, --watertight, --hole-max, --table-radius, --refine,

@@ -58,7 +58,7 @@ std::expected<HandheldTally, std::string> trackHandheld(
       auto& frames = pending[number];
       frames.push_back(std::move(event->frame));
       if (std::ssize(frames) == info.cameras) {
-        scan::RangeView view = viewOf(frames, info);
+        const scan::RangeView view = viewOf(frames, info);
         pending.erase(pending.begin(), pending.upper_bound(number));
         const auto start = Clock::now();
         const scan::TrackResult result = tracker.track(view);

@@ -87,7 +87,7 @@ std::expected<std::vector<scan::RangeView>, std::string> captureTurntableViews(
   }
   std::vector<scan::RangeView> views;
   for (int k = 0; k < options.views; ++k) {
-    const std::int64_t turn = static_cast<std::int64_t>(
+    const auto turn = static_cast<std::int64_t>(
         std::llround(360e6 * static_cast<double>(k) / static_cast<double>(options.views)));
     auto state = client.turnTurntable(protocol::TurnMode::kAbsolute, start->angleUdeg + turn,
                                       options.moveTimeout);

@@ -1,6 +1,7 @@
 #include "sim_table_calibration.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -36,6 +37,7 @@ TableLine defaultTableLine(const algo::Rig& rig) {
 
 std::vector<double> tableAngles(int count) {
   std::vector<double> angles;
+  angles.reserve(static_cast<std::size_t>(std::max(count, 0)));
   for (int i = 0; i < count; ++i) {
     angles.push_back(count == 1 ? 0.0 : -kSpanDeg + 2.0 * kSpanDeg * i / (count - 1));
   }

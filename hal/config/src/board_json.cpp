@@ -175,7 +175,8 @@ void readTriggers(Reader& r, const Json& doc, const algo::Rig& rig, hal::BoardCo
 
 // A GPIO line of the turntable: required (`required`) or optional, on no trigger line of its chip.
 std::optional<unsigned> turntableLine(Reader& r, const Json& table, std::string_view key,
-                                      bool required, const hal::BoardConfig& board) {
+                                      bool required, const hal::BoardConfig& board,
+                                      const std::string& chip) {
   const std::string at = member("turntable", key);
   int offset = -1;
   r.integer(table, "turntable", key, 0, 511, "the line offset on the chip", offset);
@@ -187,7 +188,7 @@ std::optional<unsigned> turntableLine(Reader& r, const Json& table, std::string_
   }
   const auto line = static_cast<unsigned>(offset);
   for (const auto& trigger : board.trigger.lines) {
-    if (r.ok() && trigger.chip == board.turntable->chip && trigger.offset == line) {
+    if (r.ok() && trigger.chip == chip && trigger.offset == line) {
       r.fail(at, "line " + std::to_string(line) + " of " + trigger.chip +
                      " is already the trigger line of " + jsonQuote(trigger.role));
     }
@@ -203,9 +204,9 @@ void readTurntable(Reader& r, const Json& doc, hal::BoardConfig& board) {
   }
   hal::TurntableConfig& t = board.turntable.emplace();
   t.chip = r.text(*table, "turntable", "chip", "the GPIO chip, e.g. \"gpiochip0\"").value_or("");
-  t.stepLine = turntableLine(r, *table, "step", true, board).value_or(0);
-  t.dirLine = turntableLine(r, *table, "dir", true, board).value_or(0);
-  t.enableLine = turntableLine(r, *table, "enable", false, board);
+  t.stepLine = turntableLine(r, *table, "step", true, board, t.chip).value_or(0);
+  t.dirLine = turntableLine(r, *table, "dir", true, board, t.chip).value_or(0);
+  t.enableLine = turntableLine(r, *table, "enable", false, board, t.chip);
   if (r.ok() && t.dirLine == t.stepLine) {
     r.fail("turntable.dir", "line " + std::to_string(t.dirLine) + " is already the STEP line");
   }

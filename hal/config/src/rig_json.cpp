@@ -389,7 +389,7 @@ void checkTurntable(Reader& r, const algo::TurntableAxis& t) {
   checkFinite(r, t.point, "turntable.point");
   checkWithin(r, t.point, kMaxTranslationM, "turntable.point", "a coordinate (metres)");
   const double norm = std::hypot(t.axis[0], t.axis[1], t.axis[2]);
-  if (r.ok() && !(norm > 0 && std::isfinite(norm))) {
+  if (r.ok() && (norm <= 0 || !std::isfinite(norm))) {
     r.fail("turntable.axis", "must be a direction (not the zero vector), e.g. [0, -1, 0]");
   }
 }

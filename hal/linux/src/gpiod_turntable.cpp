@@ -1,10 +1,10 @@
 #include "smx/linux/gpiod_turntable.hpp"
 
 #include <gpiod.h>
-#include <time.h>
 
 #include <cerrno>
 #include <cstdlib>
+#include <ctime>
 #include <system_error>
 
 #include "smx/hal/turntable_motion.hpp"

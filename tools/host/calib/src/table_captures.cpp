@@ -44,9 +44,9 @@ std::expected<std::vector<TableViewUse>, std::string> parseViews(std::string_vie
   const nlohmann::json* views = r.find(*doc, "views");
   if (views == nullptr || !views->is_array() || views->empty() ||
       views->size() > static_cast<std::size_t>(kMaxTableViews)) {
-    return std::unexpected(text::printfText(
-        "views: must be an array of 1 to %d views {\"id\": NAME, \"angle_deg\": A}",
-        kMaxTableViews));
+    return std::unexpected(
+        text::printfText(R"(views: must be an array of 1 to %d views {"id": NAME, "angle_deg": A})",
+                         kMaxTableViews));
   }
   std::vector<TableViewUse> out;
   for (std::size_t i = 0; i < views->size(); ++i) {

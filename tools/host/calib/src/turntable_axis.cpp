@@ -113,8 +113,8 @@ std::expected<AxisFit, std::string> fitTurntableAxis(std::span<const TableView> 
   for (const auto& view : views) {
     world.push_back(worldCorners(view, corners));
   }
-  Eigen::Vector3d u = fit.direction.unitOrthogonal();
-  Eigen::Vector3d w = fit.direction.cross(u);
+  const Eigen::Vector3d u = fit.direction.unitOrthogonal();
+  const Eigen::Vector3d w = fit.direction.cross(u);
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
   for (std::size_t i = 0; i < views.size(); ++i) {

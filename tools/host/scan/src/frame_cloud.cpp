@@ -43,8 +43,8 @@ Cloud FrameCloud::points(const RangeView& view) const {
     std::vector<Eigen::Vector3d> grid(t.rays.size(), Eigen::Vector3d::Zero());
     for (int r = 0; r < t.rows; ++r) {
       for (int c = 0; c < t.columns; ++c) {
-        const auto x = static_cast<std::size_t>(c * options_.step);
-        const auto y = static_cast<std::size_t>(r * options_.step);
+        const auto x = static_cast<std::size_t>(c) * static_cast<std::size_t>(options_.step);
+        const auto y = static_cast<std::size_t>(r) * static_cast<std::size_t>(options_.step);
         const double z =
             range.depth[y * static_cast<std::size_t>(range.width) + x] * view.depthUnitM;
         const std::size_t i = static_cast<std::size_t>(r) * static_cast<std::size_t>(t.columns) +
@@ -54,7 +54,8 @@ Cloud FrameCloud::points(const RangeView& view) const {
         }
       }
     }
-    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(t.camera.R.data());
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> rotation(
+        t.camera.R.data());
     const Eigen::Vector3d tr(t.camera.t[0], t.camera.t[1], t.camera.t[2]);
     const auto at = [&](int c, int r) -> const Eigen::Vector3d& {
       return grid[static_cast<std::size_t>(r) * static_cast<std::size_t>(t.columns) +
@@ -86,8 +87,8 @@ Cloud FrameCloud::points(const RangeView& view) const {
           n = -n;  // towards the camera
         }
         // Device → rig world: X = Rᵀ·(x − t).
-        out.points.emplace_back(R.transpose() * (p - tr));
-        out.normals.emplace_back(R.transpose() * n);
+        out.points.emplace_back(rotation.transpose() * (p - tr));
+        out.normals.emplace_back(rotation.transpose() * n);
       }
     }
   }

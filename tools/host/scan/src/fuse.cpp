@@ -67,8 +67,9 @@ class Fuser {
 
   void makeClouds() {
     const CloudOptions cloudOptions{.voxelM = options_.registrationVoxelM};
-    for (std::size_t i = 0; i < views_.size(); ++i) {
-      clouds_.push_back(viewCloud(rig_, views_[i], cloudOptions));
+    clouds_.reserve(views_.size());
+    for (const auto& view : views_) {
+      clouds_.push_back(viewCloud(rig_, view, cloudOptions));
     }
     say("clouds of " + std::to_string(views_.size()) + " views at " +
         fixed(options_.registrationVoxelM * 1e3, 1) + " mm");
@@ -262,8 +263,9 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
   Placement placement;
   if (allGiven) {
     std::vector<Pose> given;
+    given.reserve(givenPoses.size());
     for (const auto& p : givenPoses) {
-      given.push_back(*p);
+      given.push_back(p.value_or(Pose::Identity()));  // all set: allGiven
     }
     report.placement = "given";
     if (options.refine) {
@@ -276,12 +278,15 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
     }
   } else if (allAngles && options.axis) {
     report.placement = "turntable";
+    const TurntableAxis& axis = *options.axis;  // NOLINT(bugprone-unchecked-optional-access)
     std::vector<Pose> initial;
+    initial.reserve(views.size());
     for (const auto& v : views) {
-      initial.push_back(turntablePose(*options.axis, *v.turntableDeg));
+      initial.push_back(turntablePose(axis, v.turntableDeg.value_or(0.0)));  // all set: allAngles
     }
     // A ring only when the views go round: the first and last overlap.
-    const double span = std::abs(*views.back().turntableDeg - *views.front().turntableDeg);
+    const double span = std::abs(views.back().turntableDeg.value_or(0.0) -
+                                 views.front().turntableDeg.value_or(0.0));
     const double step = span / static_cast<double>(views.size() - 1);
     const bool ring = span + 1.5 * step >= 360.0;
     placement = fuser.refined(initial, ring, options.refine, report);

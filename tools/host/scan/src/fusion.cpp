@@ -34,13 +34,13 @@ struct PinholeCamera {
 
 PinholeCamera pinholeOf(const algo::Camera& camera) {
   PinholeCamera out;
-  Eigen::Matrix3d K;
-  K << camera.K[0], camera.K[1], camera.K[2], camera.K[3], camera.K[4], camera.K[5], camera.K[6],
+  Eigen::Matrix3d k;
+  k << camera.K[0], camera.K[1], camera.K[2], camera.K[3], camera.K[4], camera.K[5], camera.K[6],
       camera.K[7], camera.K[8];
-  out.intrinsic = open3d::camera::PinholeCameraIntrinsic(camera.width, camera.height, K);
+  out.intrinsic = open3d::camera::PinholeCameraIntrinsic(camera.width, camera.height, k);
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
-      out.fromRig(r, c) = camera.R[static_cast<std::size_t>(3 * r + c)];
+      out.fromRig(r, c) = camera.R[(3 * static_cast<std::size_t>(r)) + static_cast<std::size_t>(c)];
     }
     out.fromRig(r, 3) = camera.t[static_cast<std::size_t>(r)];
   }

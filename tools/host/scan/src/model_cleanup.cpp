@@ -5,6 +5,8 @@
 #include <open3d/geometry/TriangleMesh.h>
 
 #include <algorithm>
+#include <tuple>
+#include <vector>
 
 #include "open3d_bridge.hpp"
 
@@ -20,8 +22,13 @@ CleanupReport removeLoosePieces(Mesh& mesh, Cloud& model, double minShare, doubl
   o3d.vertex_normals_ = mesh.normals;
   o3d.vertex_colors_ = mesh.colours;
   o3d.triangles_ = mesh.triangles;
-  const auto [clusterOf, trianglesIn, area] = o3d.ClusterConnectedTriangles();
-  const std::size_t largest = *std::ranges::max_element(trianglesIn);
+  const auto clusters = o3d.ClusterConnectedTriangles();
+  const std::vector<int>& clusterOf = std::get<0>(clusters);
+  const std::vector<std::size_t>& trianglesIn = std::get<1>(clusters);
+  if (trianglesIn.empty()) {
+    return report;
+  }
+  const std::size_t largest = std::ranges::max(trianglesIn);
   const auto keep = [&](int cluster) {
     return static_cast<double>(trianglesIn[static_cast<std::size_t>(cluster)]) >=
            minShare * static_cast<double>(largest);

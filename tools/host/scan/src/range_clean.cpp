@@ -28,7 +28,7 @@ std::vector<std::uint8_t> edges(const CameraRange& r, double jumpPerPx) {
         edge[at(r, x, y)] = 1;
         continue;
       }
-      for (const auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
         const int nx = x + dx;
         const int ny = y + dy;
         if (nx < 0 || ny < 0 || nx >= r.width || ny >= r.height) {

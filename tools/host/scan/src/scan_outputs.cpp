@@ -135,7 +135,9 @@ std::expected<void, std::string> writeMeshStl(const std::filesystem::path& path,
     const auto& b = mesh.vertices[static_cast<std::size_t>(t[1])];
     const auto& c = mesh.vertices[static_cast<std::size_t>(t[2])];
     Eigen::Vector3d n = (b - a).cross(c - a);
-    n = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+    if (n.norm() > 0) {
+      n.normalize();
+    }
     putVector(out, n);
     putVector(out, a);
     putVector(out, b);

@@ -66,8 +66,8 @@ struct Tracker::Impl {
     const auto& cam0 = rig.cameras.front();
     const auto c = algo::lens::centre(cam0);
     centre = {c[0], c[1], c[2]};
-    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(cam0.R.data());
-    forward = R.transpose() * Eigen::Vector3d::UnitZ();
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> rotation(cam0.R.data());
+    forward = rotation.transpose() * Eigen::Vector3d::UnitZ();
   }
 
   TrackResult track(const RangeView& view);
@@ -134,13 +134,14 @@ TrackQuality Tracker::Impl::quality(const Registration& r) const {
 // keyframes nearest the last good pose; each must register to the model as a good frame does,
 // so a resumed track agrees with the model (no jump).
 std::optional<Registration> Tracker::Impl::relocalise(const Cloud& frame) {
-  std::vector<Pose> guesses = {lastGood * repeated(velocity, sinceGood), lastGood};
+  const std::vector<Pose> guesses = {lastGood * repeated(velocity, sinceGood), lastGood};
   for (const Pose& guess : guesses) {
     if (auto r = toModel(frame, guess); r && quality(*r).good) {
       return r;
     }
   }
   std::vector<const Keyframe*> nearest;
+  nearest.reserve(keyframes.size());
   for (const auto& k : keyframes) {
     nearest.push_back(&k);
   }
@@ -211,11 +212,13 @@ TrackResult Tracker::Impl::track(const RangeView& view) {
     return out;
   }
   if (!lost) {
-    if (auto r = toModel(frame, predicted); r && weak(*r)) {
+    const auto r = toModel(frame, predicted);
+    if (r && weak(*r)) {
       accept(frame, *r, out);
       out.state = TrackingState::kTracking;
       return out;
-    } else if (r) {
+    }
+    if (r) {
       out.quality = quality(*r);
     }
     lost = true;

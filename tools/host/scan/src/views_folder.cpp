@@ -22,7 +22,6 @@ using Json = nlohmann::json;
 constexpr std::array<std::string_view, 5> kTopKeys = {"format", "depth_unit_m", "mode", "views",
                                                       "turntable_axis"};
 constexpr std::array<std::string_view, 4> kViewKeys = {"id", "capture_ns", "turntable_deg", "pose"};
-constexpr std::array<std::string_view, 2> kAxisKeys = {"direction", "point"};
 
 // views.json lists views, not pixels: 10 MB is a few ten thousand views.
 constexpr config::DocumentSpec kViewsDocument = {.name = "views.json",
@@ -72,8 +71,9 @@ std::expected<TurntableAxis, std::string> axisOf(const Json& j, const fs::path& 
                                                  const std::string& field,
                                                  std::string_view directionKey) {
   if (!j.is_object() || !j.contains(directionKey) || !j.contains("point")) {
-    return std::unexpected(fail(
-        file, field, "must be an object with \"" + std::string(directionKey) + "\" and \"point\""));
+    return std::unexpected(
+        fail(file, field,
+             R"(must be an object with ")" + std::string(directionKey) + R"(" and "point")"));
   }
   auto direction =
       vector3(j[std::string(directionKey)], file, field + "." + std::string(directionKey));
@@ -154,7 +154,7 @@ std::expected<ScanMode, std::string> modeOf(const Json& j, const fs::path& file)
   if (j == "stream") {
     return ScanMode::kStream;
   }
-  return std::unexpected(fail(file, "mode", "must be \"turntable\", \"handheld\" or \"stream\""));
+  return std::unexpected(fail(file, "mode", R"(must be "turntable", "handheld" or "stream")"));
 }
 
 std::string_view modeName(ScanMode mode) {
@@ -288,7 +288,7 @@ std::optional<std::pair<std::size_t, std::uint64_t>> streamFrame(const std::stri
     return std::nullopt;
   }
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
-    if (rig.cameras[c].id == std::string_view(stem).substr(0, underscore)) {
+    if (rig.cameras[c].id == std::string_view{stem}.substr(0, underscore)) {
       return std::pair{c, n};
     }
   }

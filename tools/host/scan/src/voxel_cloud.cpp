@@ -38,7 +38,7 @@ Cloud VoxelCloud::cloud() const {
   out.normals.reserve(voxels_.size());
   for (const auto& [k, s] : voxels_) {
     const double n = s.normal.norm();
-    out.points.push_back(s.point / s.count);
+    out.points.emplace_back(s.point / s.count);
     out.normals.push_back(n > 0 ? Eigen::Vector3d(s.normal / n) : Eigen::Vector3d::UnitZ());
   }
   return out;
@@ -58,7 +58,7 @@ Cloud VoxelCloud::visible(const Eigen::Vector3d& centre, const Eigen::Vector3d& 
       continue;
     }
     out.points.push_back(p);
-    out.normals.push_back(s.normal / n);
+    out.normals.emplace_back(s.normal / n);
   }
   return out;
 }

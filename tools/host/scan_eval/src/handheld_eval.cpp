@@ -135,7 +135,7 @@ HandheldEvalResult runHandheldEval(const HandheldEvalOptions& options) {
   result.trackMsP95 = percentile(trackMs, 0.95);
 
   // The fused frames at their tracked poses, fused as the scan command's fuse step does.
-  std::vector<std::optional<scan::Pose>> given(fusedPoses.begin(), fusedPoses.end());
+  const std::vector<std::optional<scan::Pose>> given(fusedPoses.begin(), fusedPoses.end());
   scan::FuseOptions fuse;
   fuse.voxelM = options.voxelM;
   auto fused = scan::fuseViews(fusedViews, rig, given, fuse);

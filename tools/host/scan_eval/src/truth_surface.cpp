@@ -21,7 +21,7 @@ std::shared_ptr<open3d::geometry::TriangleMesh> localSurface(const sim::Shape& s
   if (const auto* m = std::get_if<sim::Mesh>(&shape)) {
     auto mesh = std::make_shared<TriangleMesh>();
     for (const auto& v : m->vertices) {
-      mesh->vertices_.push_back(v.cast<double>());
+      mesh->vertices_.emplace_back(v.cast<double>());
     }
     for (const auto& t : m->triangles) {
       mesh->triangles_.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
@@ -80,7 +80,8 @@ namespace {
 std::vector<double> distances(const std::vector<Eigen::Vector3d>& points,
                               const open3d::geometry::TriangleMesh& surface) {
   if (points.empty() || surface.triangles_.empty()) {
-    return std::vector<double>(points.size(), std::numeric_limits<double>::infinity());
+    std::vector<double> none(points.size(), std::numeric_limits<double>::infinity());
+    return none;
   }
   open3d::t::geometry::RaycastingScene raycast;
   raycast.AddTriangles(open3d::t::geometry::TriangleMesh::FromLegacy(surface));
@@ -93,7 +94,7 @@ std::vector<double> distances(const std::vector<Eigen::Vector3d>& points,
   const open3d::core::Tensor tensor(query, {static_cast<std::int64_t>(points.size()), 3},
                                     open3d::core::Float32);
   const auto result = raycast.ComputeDistance(tensor);
-  const float* d = result.GetDataPtr<float>();
+  const auto* d = result.GetDataPtr<float>();
   return {d, d + points.size()};
 }
 

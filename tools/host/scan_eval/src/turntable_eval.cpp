@@ -128,7 +128,7 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
                                       .point = {mount.pivot.x(), mount.pivot.y(), mount.pivot.z()}};
 
   // Distances to everything on the table; coverage of the scanned object.
-  open3d::geometry::TriangleMesh truth = trueSurface(scene, false);
+  const open3d::geometry::TriangleMesh truth = trueSurface(scene, false);
   open3d::geometry::TriangleMesh scanned = trueSurface(scene, true);
   const auto sampled = scanned.SamplePointsUniformly(kSurfaceSamples);
   const std::vector<Vec3>& samples = sampled->points_;

@@ -5,6 +5,7 @@
 #include <expected>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "smx/hal/board_config.hpp"
 #include "smx/hal/turntable.hpp"
@@ -45,7 +46,7 @@ class GpiodTurntable final : public hal::Turntable {
   };
   using Line = std::unique_ptr<gpiod_line, LineReleaser>;
 
-  explicit GpiodTurntable(const hal::TurntableConfig& config) : config_(config) {}
+  explicit GpiodTurntable(hal::TurntableConfig config) : config_(std::move(config)) {}
   [[nodiscard]] std::expected<Line, std::string> request(const char* field, unsigned offset,
                                                          bool activeLow, int initial);
 

@@ -78,7 +78,7 @@ struct FuseError {
 
 // `givenPoses` is empty or one per view. Fewer than 2 views fused is an error.
 [[nodiscard]] std::expected<FuseResult, FuseError> fuseViews(
-    const std::vector<RangeView>& views, const algo::Rig& rig,
+    const std::vector<RangeView>& input, const algo::Rig& rig,
     const std::vector<std::optional<Pose>>& givenPoses, const FuseOptions& options = {});
 
 }  // namespace smx::scan
