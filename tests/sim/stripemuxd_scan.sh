@@ -51,10 +51,13 @@ nonempty() {
   done
 }
 
+# A sanitiser build decodes a frame in about a second: each frame gets two minutes, not ten seconds.
+timeout=(--timeout 120)
+
 # Turntable: six views 60° apart (to the step: 3200 steps a turn), each with depth and colour.
 start "$src/boards/sim-turntable"
 out=$work/turntable
-"$tool" scan --device "$device" --turntable --views 6 --voxel 2 --out "$out" >"$work/scan" 2>&1 ||
+"$tool" scan --device "$device" --turntable --views 6 --voxel 2 "${timeout[@]}" --out "$out" >"$work/scan" 2>&1 ||
   fail "scan --turntable: exit $?: $(cat "$work/scan")"
 json_check "$out/rig.json" '"turntable" in d' 'no "turntable" axis'
 json_check "$out/views/views.json" \
@@ -81,12 +84,18 @@ set +e
 set -e
 [ "$code" -eq 1 ] || fail "scan without a mode: exit $code, expected 1"
 [ ! -e "$work/neither/model.ply" ] || fail "scan without a mode left a model"
+set +e
+"$tool" scan --device "$device" --turntable --timeout 0 --out "$work/no_time" >/dev/null 2>"$work/err"
+code=$?
+set -e
+[ "$code" -eq 1 ] || fail "scan --timeout 0: exit $code, expected 1"
+grep -q -- "--timeout" "$work/err" || fail "the usage error does not name --timeout: $(cat "$work/err")"
 stop
 
 # Hand-held: twelve captures tracked, with their poses.
 start "$src/boards/sim-handheld"
 out=$work/handheld
-"$tool" scan --device "$device" --handheld --frames 12 --voxel 2 --out "$out" >"$work/scan" 2>&1 ||
+"$tool" scan --device "$device" --handheld --frames 12 --voxel 2 "${timeout[@]}" --out "$out" >"$work/scan" 2>&1 ||
   fail "scan --handheld: exit $?: $(cat "$work/scan")"
 json_check "$out/views/views.json" \
   'd["mode"] == "handheld" and len(d["views"]) >= 2 and all(len(v["pose"]) == 16 for v in d["views"])' \

@@ -30,7 +30,7 @@ algo::Rig pinholeRig() {
 
 // The plane n·X = d seen by the pinhole camera: z = d / (n · (x_n, y_n, 1)).
 RangeView planeView(const Eigen::Vector3d& normal, double d) {
-  const algo::Camera& c = pinholeRig().cameras[0];
+  const algo::Camera c = pinholeRig().cameras[0];
   CameraRange range{.width = kWidth, .height = kHeight, .depth = {}, .colour = {}};
   for (int y = 0; y < kHeight; ++y) {
     for (int x = 0; x < kWidth; ++x) {
@@ -113,7 +113,7 @@ TEST(TableCrop, OnlyPointsWithinTheRadiusOfTheAxisStay) {
   const TurntableAxis axis{.direction = Eigen::Vector3d(0, -1, 0),
                            .point = Eigen::Vector3d(0, 0, 0.8)};
   keepOnTable(view, pinholeRig(), axis, 0.1);
-  const algo::Camera& c = pinholeRig().cameras[0];
+  const algo::Camera c = pinholeRig().cameras[0];
   for (int x = 0; x < kWidth; ++x) {
     const double worldX = (x - c.cx()) / c.fx() * 0.8;
     if (std::abs(std::abs(worldX) - 0.1) < 0.002) {

@@ -7,6 +7,7 @@
 // meshed as `stripemux fuse DIR` does.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <memory>
 #include <string>
@@ -34,8 +35,13 @@ struct ScanOptions {
   bool handheld = false;
   int frames = 0;
   bool noColour = false;
+  double timeoutS = 10;
   FuseFolderOptions fuse;
 };
+
+std::chrono::milliseconds frameTimeout(const ScanOptions& opts) {
+  return std::chrono::milliseconds(std::llround(opts.timeoutS * 1000));
+}
 
 int fail(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux scan: " << printable(message) << "\n";
@@ -66,7 +72,8 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
   const DeviceInfo& info = client->info();
   // A device without a table is told apart from a table without a calibrated axis: the advice
   // differs.
-  const TurntableCaptureOptions capture{.views = opts.views, .colour = !opts.noColour};
+  const TurntableCaptureOptions capture{
+      .views = opts.views, .colour = !opts.noColour, .frameTimeout = frameTimeout(opts)};
   auto table = client->turntableStatus(capture.frameTimeout);
   if (!table && !table.error().absent) {
     return fail(io, kExitDeviceOrIo, table.error().message);
@@ -155,7 +162,7 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
   scan::TrackingState lastState = scan::TrackingState::kTracking;
   interrupted.store(false);
   const auto previous = std::signal(SIGINT, onInterrupt);
-  const HandheldCaptureOptions capture{.frames = opts.frames};
+  const HandheldCaptureOptions capture{.frames = opts.frames, .frameTimeout = frameTimeout(opts)};
   int captures = 0;
   int fused = 0;
   auto tally = trackHandheld(
@@ -244,6 +251,9 @@ void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       ->needs(handheld);
   cmd->add_flag("--no-colour", opts->noColour,
                 "Skip the projector-off frame of each view (the model is grey)");
+  cmd->add_option("--timeout", opts->timeoutS,
+                  "Seconds to wait for each frame and status answer (default 10)")
+      ->check(CLI::Range(0.1, 3600.0));
   addFuseOptions(*cmd, opts->fuse);
   cmd->callback([opts, &io, &exitCode] {
     if (!opts->turntable && !opts->handheld) {
