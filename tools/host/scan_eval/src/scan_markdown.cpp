@@ -39,6 +39,10 @@ std::string scanResultsMarkdown(const TurntableEvalResult& t, const HandheldEval
       printfText("| coverage of the object's surface the views see | %.1f %% | ≥ 95 %% | %s |\n",
                  100.0 * t.coverage, verdict(t.coverage >= 0.95)) +
       printfText(
+          "| the rest: never decoded / decoded but cleaned away / kept but not meshed within 1 "
+          "mm | %.1f / %.1f / %.1f %% | | |\n",
+          100.0 * t.missedUndecoded, 100.0 * t.missedCleaned, 100.0 * t.missedUnmeshed) +
+      printfText(
           "| registration, fusion and meshing after the last view | %.1f s | ≤ 60 s | %s "
           "|\n",
           t.fuseS, verdict(t.fuseS <= 60.0)) +
@@ -48,7 +52,16 @@ std::string scanResultsMarkdown(const TurntableEvalResult& t, const HandheldEval
       printfText(
           "\nRendering and decoding the views took %.0f s (the simulator's cost, not the "
           "scan's).\n",
-          t.decodeS);
+          t.decodeS) +
+      "\nWhat the range cleaning's margin at holes and depth jumps trades (the same views fused "
+      "again with a narrower margin; [scanning](scanning.md#what-a-view-gives-the-model)):\n\n"
+      "| margin | mesh to true surface, mean | 95th percentile | coverage "
+      "|\n|---:|---:|---:|---:|\n";
+  for (const MarginResult& m : t.margins) {
+    md += printfText("| %d px%s | %.3f mm | %.3f mm | %.1f %% |\n", m.edgePx,
+                     &m == &t.margins.front() ? " (the scan's)" : "", m.meanMm, m.p95Mm,
+                     100.0 * m.coverage);
+  }
   const double fps = h.trackMsMean > 0 ? 1000.0 / h.trackMsMean : 0.0;
   md += "\n## Hand-held\n\n" +
         printfText(

@@ -100,10 +100,11 @@ std::vector<double> distances(const std::vector<Eigen::Vector3d>& points,
 
 }  // namespace
 
-std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
-                        const open3d::geometry::TriangleMesh& surface, double distanceM) {
+std::vector<char> withinMask(const std::vector<Eigen::Vector3d>& points,
+                             const open3d::geometry::TriangleMesh& surface, double distanceM) {
+  std::vector<char> within(points.size(), 0);
   if (points.empty() || surface.triangles_.empty()) {
-    return 0;
+    return within;
   }
   // Sampled densely rather than ray-cast: Open3D's closest-point query asserts on the sliver
   // triangles marching cubes makes. A sample every ~0.2·distance leaves the count within a few
@@ -116,13 +117,16 @@ std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
   const open3d::geometry::KDTreeFlann tree(*dense);
   std::vector<int> index(1);
   std::vector<double> distance2(1);
-  std::size_t within = 0;
-  for (const auto& p : points) {
-    if (tree.SearchKNN(p, 1, index, distance2) > 0 && distance2[0] <= distanceM * distanceM) {
-      ++within;
-    }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    within[i] = static_cast<char>(tree.SearchKNN(points[i], 1, index, distance2) > 0 &&
+                                  distance2[0] <= distanceM * distanceM);
   }
   return within;
+}
+
+std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
+                        const open3d::geometry::TriangleMesh& surface, double distanceM) {
+  return static_cast<std::size_t>(std::ranges::count(withinMask(points, surface, distanceM), 1));
 }
 
 DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,

@@ -28,6 +28,11 @@ struct DistanceStats {
 [[nodiscard]] DistanceStats distancesToSurface(const std::vector<Eigen::Vector3d>& vertices,
                                                const open3d::geometry::TriangleMesh& surface);
 
+// For each of `points`, 1 when it lies within `distanceM` of the surface.
+[[nodiscard]] std::vector<char> withinMask(const std::vector<Eigen::Vector3d>& points,
+                                           const open3d::geometry::TriangleMesh& surface,
+                                           double distanceM);
+
 // How many of `points` lie within `distanceM` of the surface.
 [[nodiscard]] std::size_t countWithin(const std::vector<Eigen::Vector3d>& points,
                                       const open3d::geometry::TriangleMesh& surface,

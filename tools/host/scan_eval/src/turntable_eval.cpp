@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <variant>
 
@@ -15,6 +16,8 @@
 #include "smx/algo/range_image.hpp"
 #include "smx/eval/sim_frame.hpp"
 #include "smx/scan/fuse.hpp"
+#include "smx/scan/range_clean.hpp"
+#include "smx/scan/table_crop.hpp"
 #include "smx/text/printf_text.hpp"
 #include "truth_surface.hpp"
 
@@ -73,38 +76,114 @@ open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene, bool scanned
   return all;
 }
 
+struct Projected {
+  int x = 0;
+  int y = 0;
+  double z = 0.0;  // depth along the camera's axis
+};
+
+// Where the model-frame point `p` falls in `camera` with the table turned by `deg`.
+std::optional<Projected> project(const algo::Camera& camera, const sim::TurntableMount& mount,
+                                 double deg, const Vec3& p) {
+  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+  const Vec3 w = q * (p - mount.pivot) + mount.pivot;
+  const lens::Point3 world{w.x(), w.y(), w.z()};
+  const auto uv = lens::project(camera, world);
+  if (!uv) {
+    return std::nullopt;
+  }
+  const int x = static_cast<int>(std::lround(uv->x));
+  const int y = static_cast<int>(std::lround(uv->y));
+  if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
+    return std::nullopt;
+  }
+  return Projected{.x = x, .y = y, .z = lens::toDevice(camera, world)[2]};
+}
+
 // Marks the samples (model frame) that camera `camera` sees lit in `frame`, rendered with the
 // table at `deg`.
 void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scene, double deg,
                  const std::vector<Vec3>& samples, std::vector<char>& seen) {
-  const auto& mount = mountOf(scene);
-  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
   const auto& device = frame.rig.cameras.at(static_cast<std::size_t>(camera));
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (seen[i] != 0) {
       continue;
     }
-    const Vec3 w = q * (samples[i] - mount.pivot) + mount.pivot;
-    const lens::Point3 world{w.x(), w.y(), w.z()};
-    const auto uv = lens::project(device, world);
-    if (!uv) {
+    const auto at = project(device, mountOf(scene), deg, samples[i]);
+    if (!at) {
       continue;
     }
-    const int x = static_cast<int>(std::lround(uv->x));
-    const int y = static_cast<int>(std::lround(uv->y));
-    if (x < 0 || y < 0 || x >= device.width || y >= device.height) {
-      continue;
-    }
-    const double z = lens::toDevice(device, world)[2];
-    const double truth = frame.depth.at(x, y);
+    const double truth = frame.depth.at(at->x, at->y);
     bool lit = false;
     for (const auto& mask : frame.lit) {
-      lit = lit || mask.at(x, y) != 0;
+      lit = lit || mask.at(at->x, at->y) != 0;
     }
-    if (lit && std::isfinite(truth) && std::abs(z - truth) < kVisibleM) {
+    if (lit && std::isfinite(truth) && std::abs(at->z - truth) < kVisibleM) {
       seen[i] = 1;
     }
   }
+}
+
+// Whether some camera of some view has depth within kVisibleM of the model-frame point `p`.
+bool inSomeView(const std::vector<scan::RangeView>& views, const algo::Rig& rig,
+                const sim::TurntableMount& mount, const Vec3& p) {
+  for (const auto& view : views) {
+    for (std::size_t c = 0; c < view.cameras.size() && c < rig.cameras.size(); ++c) {
+      const auto& range = view.cameras[c];
+      const auto at = project(rig.cameras[c], mount, view.turntableDeg.value_or(0.0), p);
+      if (!at || range.depth.empty()) {
+        continue;
+      }
+      const std::uint16_t z =
+          range.depth[static_cast<std::size_t>(at->y) * static_cast<std::size_t>(range.width) +
+                      static_cast<std::size_t>(at->x)];
+      if (z != 0 && std::abs(z * view.depthUnitM - at->z) < kVisibleM) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+struct Measured {
+  double fuseS = 0.0;
+  int fusedViews = 0;
+  double loopClosureMm = 0.0;
+  std::size_t meshVertices = 0;
+  MarginResult margin;
+  std::vector<char> covered;  // per seen sample: the mesh within kCoveredM
+};
+
+// `views` fused with `fuse`, the mesh against the true surface and the seen samples.
+Measured fuseAndMeasure(const std::vector<scan::RangeView>& views, const algo::Rig& rig,
+                        const scan::FuseOptions& fuse, const open3d::geometry::TriangleMesh& truth,
+                        const std::vector<Vec3>& seenSamples) {
+  Measured m;
+  const auto fuseStart = Clock::now();
+  auto fused = scan::fuseViews(views, rig, {}, fuse);
+  m.fuseS = seconds(fuseStart);
+  if (!fused) {
+    throw std::runtime_error("fusing the views: " + fused.error().message);
+  }
+  m.fusedViews = static_cast<int>(fused->report.fusedViews);
+  m.loopClosureMm = fused->report.loopClosureM * 1000.0;
+  const auto& vertices = fused->mesh.vertices;
+  m.meshVertices = vertices.size();
+  if (vertices.empty()) {
+    throw std::runtime_error("the fused mesh is empty");
+  }
+  const auto distance = detail::distancesToSurface(vertices, truth);
+  open3d::geometry::TriangleMesh fusedMesh;
+  fusedMesh.vertices_ = vertices;
+  fusedMesh.triangles_ = fused->mesh.triangles;
+  m.covered = detail::withinMask(seenSamples, fusedMesh, kCoveredM);
+  const auto covered = static_cast<double>(std::ranges::count(m.covered, 1));
+  m.margin = MarginResult{
+      .edgePx = fuse.clean.edgePx,
+      .meanMm = distance.meanMm,
+      .p95Mm = distance.p95Mm,
+      .coverage = seenSamples.empty() ? 0.0 : covered / static_cast<double>(seenSamples.size())};
+  return m;
 }
 
 }  // namespace
@@ -164,29 +243,6 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   fuse.voxelM = options.voxelM;
   fuse.axis = scan::TurntableAxis{.direction = mount.axis.normalized(), .point = mount.pivot};
   fuse.tableRadiusM = options.tableRadiusM;
-  const auto fuseStart = Clock::now();
-  auto fused = scan::fuseViews(views, rig, {}, fuse);
-  result.fuseS = seconds(fuseStart);
-  if (!fused) {
-    throw std::runtime_error("fusing the views: " + fused.error().message);
-  }
-  result.fusedViews = static_cast<int>(fused->report.fusedViews);
-  result.loopClosureMm = fused->report.loopClosureM * 1000.0;
-  const auto& vertices = fused->mesh.vertices;
-  result.meshVertices = vertices.size();
-  if (vertices.empty()) {
-    throw std::runtime_error("the fused mesh is empty");
-  }
-
-  // Vertices to the true surface.
-  const auto distance = detail::distancesToSurface(vertices, truth);
-  result.meanMm = distance.meanMm;
-  result.p95Mm = distance.p95Mm;
-
-  // The seen surface within reach of the mesh's triangles.
-  open3d::geometry::TriangleMesh fusedMesh;
-  fusedMesh.vertices_ = vertices;
-  fusedMesh.triangles_ = fused->mesh.triangles;
   std::vector<Vec3> seenSamples;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (seen[i] != 0) {
@@ -194,8 +250,58 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
     }
   }
   const std::size_t visible = seenSamples.size();
-  const std::size_t covered = detail::countWithin(seenSamples, fusedMesh, kCoveredM);
-  result.coverage = visible > 0 ? static_cast<double>(covered) / static_cast<double>(visible) : 0;
+  const Measured measured = fuseAndMeasure(views, rig, fuse, truth, seenSamples);
+  result.fuseS = measured.fuseS;
+  result.fusedViews = measured.fusedViews;
+  result.loopClosureMm = measured.loopClosureMm;
+  result.meshVertices = measured.meshVertices;
+  result.meanMm = measured.margin.meanMm;
+  result.p95Mm = measured.margin.p95Mm;
+  result.coverage = measured.margin.coverage;
+  result.margins.push_back(measured.margin);
+  const auto& covered = measured.covered;
+
+  // Where the rest was lost: the views as decoded, and as the fusion took them.
+  std::vector<scan::RangeView> cleaned = views;
+  for (auto& view : cleaned) {
+    scan::keepOnTable(view, rig, *fuse.axis, fuse.tableRadiusM);
+    scan::cleanForFusion(view, rig, fuse.clean);
+  }
+  std::size_t undecoded = 0;
+  std::size_t removed = 0;
+  std::size_t unmeshed = 0;
+  for (std::size_t i = 0; i < visible; ++i) {
+    if (covered[i] != 0) {
+      continue;
+    }
+    if (!inSomeView(views, rig, mount, seenSamples[i])) {
+      ++undecoded;
+    } else if (!inSomeView(cleaned, rig, mount, seenSamples[i])) {
+      ++removed;
+    } else {
+      ++unmeshed;
+    }
+  }
+  const auto share = [visible](std::size_t n) {
+    return visible > 0 ? static_cast<double>(n) / static_cast<double>(visible) : 0.0;
+  };
+  result.missedUndecoded = share(undecoded);
+  result.missedCleaned = share(removed);
+  result.missedUnmeshed = share(unmeshed);
+  say(text::printfText(
+      "  turntable: mesh %.3f mm mean, %.3f mm p95; coverage %.1f %% (never decoded %.1f %%, "
+      "cleaned away %.1f %%, not meshed %.1f %%)",
+      result.meanMm, result.p95Mm, 100.0 * result.coverage, 100.0 * result.missedUndecoded,
+      100.0 * result.missedCleaned, 100.0 * result.missedUnmeshed));
+
+  // The same views with narrower margins at holes and jumps.
+  for (int margin = fuse.clean.edgePx - 1; margin >= 0; --margin) {
+    fuse.clean.edgePx = margin;
+    result.margins.push_back(fuseAndMeasure(views, rig, fuse, truth, seenSamples).margin);
+    say(text::printfText("  margin %d px: mesh %.3f mm mean, %.3f mm p95; coverage %.1f %%", margin,
+                         result.margins.back().meanMm, result.margins.back().p95Mm,
+                         100.0 * result.margins.back().coverage));
+  }
   return result;
 }
 

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 // The turntable scan's figures (`stripemux eval --only scan`, docs/scan-results.md): a named scene
 // whose objects stand on a turntable, rendered at N table angles with realistic optics, decoded by
@@ -22,6 +23,14 @@ struct TurntableEvalOptions {
   std::function<void(const std::string&)> progress{};
 };
 
+// The fused mesh with the range cleaning's margin at holes and depth jumps set to edgePx.
+struct MarginResult {
+  int edgePx = 0;
+  double meanMm = 0.0;
+  double p95Mm = 0.0;
+  double coverage = 0.0;
+};
+
 struct TurntableEvalResult {
   std::string scene;
   std::string rigFile;
@@ -33,10 +42,18 @@ struct TurntableEvalResult {
   // projector in some view; the scene's meshes on the table, not its platter), the share within
   // 1 mm of the fused mesh.
   double coverage = 0.0;
+  // The rest of that surface, by where it was lost: never decoded (no view's depth within 2 mm of
+  // it), decoded but removed by the table crop or the range cleaning, or kept but without the
+  // mesh within 1 mm (fusion, meshing or the loose-piece removal).
+  double missedUndecoded = 0.0;
+  double missedCleaned = 0.0;
+  double missedUnmeshed = 0.0;
   double loopClosureMm = 0.0;
   double fuseS = 0.0;    // registration, fusion and meshing after the last view
   double decodeS = 0.0;  // rendering and decoding every view (not part of the scan's time)
   std::size_t meshVertices = 0;
+  // The scan's own margin first, then each narrower one down to 0: what the margin trades.
+  std::vector<MarginResult> margins;
 };
 
 [[nodiscard]] TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options);
