@@ -21,6 +21,11 @@ TEST(ScanEval, EveryMissHasOneCauseAndANarrowerMarginCoversMore) {
   EXPECT_NEAR(r.coverage + r.missedUndecoded + r.missedCleaned + r.missedUnmeshed, 1.0, 1e-9);
   EXPECT_GT(r.missedUndecoded, 0.0);  // six views leave parts of the bunny undecoded
   EXPECT_GT(r.missedCleaned, 0.0);
+  // Six views see much of the bunny only at grazing incidence; what some view sees nearly
+  // head-on is covered better than the whole.
+  EXPECT_GT(r.wellSeenShare, 0.3);
+  EXPECT_LT(r.wellSeenShare, 1.0);
+  EXPECT_GT(r.wellSeenCoverage, r.coverage);
 
   ASSERT_EQ(r.margins.size(), 3U);
   EXPECT_EQ(r.margins[0].edgePx, 2);

@@ -43,6 +43,10 @@ std::string scanResultsMarkdown(const TurntableEvalResult& t, const HandheldEval
           "mm | %.1f / %.1f / %.1f %% | | |\n",
           100.0 * t.missedUndecoded, 100.0 * t.missedCleaned, 100.0 * t.missedUnmeshed) +
       printfText(
+          "| coverage of the part some view sees within 60° of head-on (%.1f %% of the seen "
+          "surface) | %.1f %% | | |\n",
+          100.0 * t.wellSeenShare, 100.0 * t.wellSeenCoverage) +
+      printfText(
           "| registration, fusion and meshing after the last view | %.1f s | ≤ 60 s | %s "
           "|\n",
           t.fuseS, verdict(t.fuseS <= 60.0)) +

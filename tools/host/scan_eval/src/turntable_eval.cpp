@@ -35,6 +35,9 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 constexpr double kVisibleM = 0.002;
 constexpr double kCoveredM = 0.001;
 constexpr int kSurfaceSamples = 200000;
+// Surface some view sees within this of head-on is well posed for stripes; beyond it they
+// narrow in the camera towards the grazing limit.
+constexpr double kWellSeenDeg = 60.0;
 
 double seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
@@ -79,16 +82,24 @@ open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene, bool scanned
 struct Projected {
   int x = 0;
   int y = 0;
-  double z = 0.0;  // depth along the camera's axis
+  Vec3 device = Vec3::Zero();  // the point in the camera's frame
 };
+
+// The turntable's rotation by `deg`.
+Eigen::Matrix3d turn(const sim::TurntableMount& mount, double deg) {
+  return Eigen::Matrix3d(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+}
+
+Vec3 inDevice(const algo::Camera& camera, const Vec3& w) {
+  const auto d = lens::toDevice(camera, {w.x(), w.y(), w.z()});
+  return {d[0], d[1], d[2]};
+}
 
 // Where the model-frame point `p` falls in `camera` with the table turned by `deg`.
 std::optional<Projected> project(const algo::Camera& camera, const sim::TurntableMount& mount,
                                  double deg, const Vec3& p) {
-  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
-  const Vec3 w = q * (p - mount.pivot) + mount.pivot;
-  const lens::Point3 world{w.x(), w.y(), w.z()};
-  const auto uv = lens::project(camera, world);
+  const Vec3 w = turn(mount, deg) * (p - mount.pivot) + mount.pivot;
+  const auto uv = lens::project(camera, {w.x(), w.y(), w.z()});
   if (!uv) {
     return std::nullopt;
   }
@@ -97,19 +108,20 @@ std::optional<Projected> project(const algo::Camera& camera, const sim::Turntabl
   if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
     return std::nullopt;
   }
-  return Projected{.x = x, .y = y, .z = lens::toDevice(camera, world)[2]};
+  return Projected{.x = x, .y = y, .device = inDevice(camera, w)};
 }
 
-// Marks the samples (model frame) that camera `camera` sees lit in `frame`, rendered with the
-// table at `deg`.
+// For each sample (model frame, with its normal) that camera `camera` sees lit in `frame`,
+// rendered with the table at `deg`: the largest |cos| so far between its normal and a seeing
+// camera's ray (1: head-on). Samples no view has seen stay at -1.
 void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scene, double deg,
-                 const std::vector<Vec3>& samples, std::vector<char>& seen) {
+                 const open3d::geometry::PointCloud& samples, std::vector<double>& bestCos) {
   const auto& device = frame.rig.cameras.at(static_cast<std::size_t>(camera));
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (seen[i] != 0) {
-      continue;
-    }
-    const auto at = project(device, mountOf(scene), deg, samples[i]);
+  const auto& mount = mountOf(scene);
+  const Eigen::Matrix3d q = turn(mount, deg);
+  for (std::size_t i = 0; i < samples.points_.size(); ++i) {
+    const Vec3& p = samples.points_[i];
+    const auto at = project(device, mount, deg, p);
     if (!at) {
       continue;
     }
@@ -118,9 +130,13 @@ void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scen
     for (const auto& mask : frame.lit) {
       lit = lit || mask.at(at->x, at->y) != 0;
     }
-    if (lit && std::isfinite(truth) && std::abs(at->z - truth) < kVisibleM) {
-      seen[i] = 1;
+    if (!lit || !std::isfinite(truth) || std::abs(at->device.z() - truth) >= kVisibleM) {
+      continue;
     }
+    const Vec3 w = q * (p - mount.pivot) + mount.pivot;
+    const Vec3 normal = inDevice(device, w + q * samples.normals_[i]) - at->device;
+    const double cos = std::abs(normal.normalized().dot(at->device.normalized()));
+    bestCos[i] = std::max(bestCos[i], cos);
   }
 }
 
@@ -137,7 +153,7 @@ bool inSomeView(const std::vector<scan::RangeView>& views, const algo::Rig& rig,
       const std::uint16_t z =
           range.depth[static_cast<std::size_t>(at->y) * static_cast<std::size_t>(range.width) +
                       static_cast<std::size_t>(at->x)];
-      if (z != 0 && std::abs(z * view.depthUnitM - at->z) < kVisibleM) {
+      if (z != 0 && std::abs(z * view.depthUnitM - at->device.z()) < kVisibleM) {
         return true;
       }
     }
@@ -209,9 +225,13 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   // Distances to everything on the table; coverage of the scanned object.
   const open3d::geometry::TriangleMesh truth = trueSurface(scene, false);
   open3d::geometry::TriangleMesh scanned = trueSurface(scene, true);
-  const auto sampled = scanned.SamplePointsUniformly(kSurfaceSamples);
+  scanned.ComputeTriangleNormals();
+  const auto sampled = scanned.SamplePointsUniformly(kSurfaceSamples, true);
   const std::vector<Vec3>& samples = sampled->points_;
-  std::vector<char> seen(samples.size(), 0);
+  if (sampled->normals_.size() != samples.size()) {
+    throw std::runtime_error("the true surface's samples have no normals");
+  }
+  std::vector<double> bestCos(samples.size(), -1.0);
 
   TurntableEvalResult result;
   result.scene = options.scene;
@@ -232,7 +252,7 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
       request.seed = options.seed + static_cast<std::uint64_t>(k);
       const eval::SimFrame frame = eval::renderSimFrame(rig, at, request);
       view.cameras.push_back(detail::decoded(frame, c));
-      markVisible(frame, c, scene, deg, samples, seen);
+      markVisible(frame, c, scene, deg, *sampled, bestCos);
     }
     views.push_back(std::move(view));
     say(text::printfText("  view %d/%d at %.1f° rendered and decoded", k + 1, options.views, deg));
@@ -244,9 +264,12 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   fuse.axis = scan::TurntableAxis{.direction = mount.axis.normalized(), .point = mount.pivot};
   fuse.tableRadiusM = options.tableRadiusM;
   std::vector<Vec3> seenSamples;
+  std::vector<char> wellSeen;  // per seen sample: some view within kWellSeenDeg of head-on
+  const double wellSeenCos = std::cos(kWellSeenDeg * kRadPerDeg);
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (seen[i] != 0) {
+    if (bestCos[i] >= 0.0) {
       seenSamples.push_back(samples[i]);
+      wellSeen.push_back(static_cast<char>(bestCos[i] >= wellSeenCos));
     }
   }
   const std::size_t visible = seenSamples.size();
@@ -282,6 +305,17 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
       ++unmeshed;
     }
   }
+  std::size_t wellSeenCount = 0;
+  std::size_t wellSeenCovered = 0;
+  for (std::size_t i = 0; i < visible; ++i) {
+    wellSeenCount += wellSeen[i] != 0 ? 1 : 0;
+    wellSeenCovered += wellSeen[i] != 0 && covered[i] != 0 ? 1 : 0;
+  }
+  result.wellSeenShare =
+      visible > 0 ? static_cast<double>(wellSeenCount) / static_cast<double>(visible) : 0.0;
+  result.wellSeenCoverage =
+      wellSeenCount > 0 ? static_cast<double>(wellSeenCovered) / static_cast<double>(wellSeenCount)
+                        : 0.0;
   const auto share = [visible](std::size_t n) {
     return visible > 0 ? static_cast<double>(n) / static_cast<double>(visible) : 0.0;
   };
@@ -290,9 +324,11 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   result.missedUnmeshed = share(unmeshed);
   say(text::printfText(
       "  turntable: mesh %.3f mm mean, %.3f mm p95; coverage %.1f %% (never decoded %.1f %%, "
-      "cleaned away %.1f %%, not meshed %.1f %%)",
+      "cleaned away %.1f %%, not meshed %.1f %%); %.1f %% of it seen within %.0f° of head-on, "
+      "covered %.1f %%",
       result.meanMm, result.p95Mm, 100.0 * result.coverage, 100.0 * result.missedUndecoded,
-      100.0 * result.missedCleaned, 100.0 * result.missedUnmeshed));
+      100.0 * result.missedCleaned, 100.0 * result.missedUnmeshed, 100.0 * result.wellSeenShare,
+      kWellSeenDeg, 100.0 * result.wellSeenCoverage));
 
   // The same views with narrower margins at holes and jumps.
   for (int margin = fuse.clean.edgePx - 1; margin >= 0; --margin) {

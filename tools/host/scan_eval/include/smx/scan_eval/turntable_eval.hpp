@@ -48,6 +48,10 @@ struct TurntableEvalResult {
   double missedUndecoded = 0.0;
   double missedCleaned = 0.0;
   double missedUnmeshed = 0.0;
+  // The share of that surface some view sees within 60° of head-on, and its coverage: the part
+  // a single ring of views can be asked to cover.
+  double wellSeenShare = 0.0;
+  double wellSeenCoverage = 0.0;
   double loopClosureMm = 0.0;
   double fuseS = 0.0;    // registration, fusion and meshing after the last view
   double decodeS = 0.0;  // rendering and decoding every view (not part of the scan's time)
