@@ -308,8 +308,10 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   std::size_t wellSeenCount = 0;
   std::size_t wellSeenCovered = 0;
   for (std::size_t i = 0; i < visible; ++i) {
-    wellSeenCount += wellSeen[i] != 0 ? 1 : 0;
-    wellSeenCovered += wellSeen[i] != 0 && covered[i] != 0 ? 1 : 0;
+    if (wellSeen[i] != 0) {
+      ++wellSeenCount;
+      wellSeenCovered += covered[i] != 0 ? 1U : 0U;
+    }
   }
   result.wellSeenShare =
       visible > 0 ? static_cast<double>(wellSeenCount) / static_cast<double>(visible) : 0.0;
