@@ -115,7 +115,7 @@ std::expected<CaptureGuideOptions, std::string> guideOptions(const CaptureOption
   CaptureGuideOptions guide;
   guide.poses = opts.poses;
   guide.squareM = opts.squareM;
-  guide.captureTimeout = std::chrono::milliseconds(static_cast<long>(opts.timeoutS * 1000));
+  guide.captureTimeout = secondsOption(opts.timeoutS);
   if (!opts.target.empty()) {
     const auto x = opts.target.find('x');
     try {
@@ -149,7 +149,7 @@ int runCapture(const CaptureOptions& opts, const CliStreams& io) {
     return fail(kExitDeviceOrIo, client.error());
   }
   const algo::Rig& rig = client->info().rig;
-  const auto timeout = std::chrono::milliseconds(static_cast<long>(opts.timeoutS * 1000));
+  const auto timeout = secondsOption(opts.timeoutS);
   if (opts.guided) {
     const auto summary = captureCalibrationSet(*client, rig, *guide, opts.out, io);
     if (!summary) {

@@ -66,8 +66,7 @@ void showSent(const CliStreams& io, bool tty, std::uint64_t sent, std::uint64_t 
 // The device's update status once it is back and settled (a trial decided), retrying the
 // connection while it restarts.
 std::expected<UpdateStatusReport, Failure> awaitSettled(const FlashOptions& opts) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::milliseconds(static_cast<std::int64_t>(opts.waitS * 1000));
+  const auto deadline = std::chrono::steady_clock::now() + secondsOption(opts.waitS);
   std::string last = "no answer";
   while (std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(kRetryDelay);

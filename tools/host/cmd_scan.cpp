@@ -7,7 +7,6 @@
 // meshed as `stripemux fuse DIR` does.
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <csignal>
 #include <memory>
 #include <string>
@@ -39,10 +38,6 @@ struct ScanOptions {
   FuseFolderOptions fuse;
 };
 
-std::chrono::milliseconds frameTimeout(const ScanOptions& opts) {
-  return std::chrono::milliseconds(std::llround(opts.timeoutS * 1000));
-}
-
 int fail(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux scan: " << printable(message) << "\n";
   return code;
@@ -73,7 +68,7 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
   // A device without a table is told apart from a table without a calibrated axis: the advice
   // differs.
   const TurntableCaptureOptions capture{
-      .views = opts.views, .colour = !opts.noColour, .frameTimeout = frameTimeout(opts)};
+      .views = opts.views, .colour = !opts.noColour, .frameTimeout = secondsOption(opts.timeoutS)};
   auto table = client->turntableStatus(capture.frameTimeout);
   if (!table && !table.error().absent) {
     return fail(io, kExitDeviceOrIo, table.error().message);
@@ -162,7 +157,8 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
   scan::TrackingState lastState = scan::TrackingState::kTracking;
   interrupted.store(false);
   const auto previous = std::signal(SIGINT, onInterrupt);
-  const HandheldCaptureOptions capture{.frames = opts.frames, .frameTimeout = frameTimeout(opts)};
+  const HandheldCaptureOptions capture{.frames = opts.frames,
+                                       .frameTimeout = secondsOption(opts.timeoutS)};
   int captures = 0;
   int fused = 0;
   auto tally = trackHandheld(

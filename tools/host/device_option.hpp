@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdint>
 #include <string>
 
 #include "smx/net/tcp_client.hpp"
@@ -11,6 +12,11 @@
 namespace smx::host {
 
 inline constexpr auto kDeviceConnectTimeout = std::chrono::milliseconds(3000);
+
+// A --timeout or --wait option's seconds as a duration (whole milliseconds, truncated).
+inline std::chrono::milliseconds secondsOption(double seconds) {
+  return std::chrono::milliseconds(static_cast<std::int64_t>(seconds * 1000));
+}
 
 // A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
 inline CLI::Validator deviceAddressValidator() {

@@ -216,13 +216,8 @@ class Fuser {
 
 }  // namespace
 
-std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& input,
-                                               const algo::Rig& rig,
-                                               const std::vector<std::optional<Pose>>& givenPoses,
-                                               const FuseOptions& options) {
-  open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
-  // What the model takes of each view: a turntable's views only what turns with the table, and
-  // no view its edges or grazing pixels.
+std::vector<RangeView> viewsForFusion(const std::vector<RangeView>& input, const algo::Rig& rig,
+                                      const FuseOptions& options) {
   std::vector<RangeView> views = input;
   const bool turntable =
       options.axis && options.tableRadiusM > 0 && !input.empty() &&
@@ -233,6 +228,15 @@ std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& inp
     }
     cleanForFusion(view, rig, options.clean);
   }
+  return views;
+}
+
+std::expected<FuseResult, FuseError> fuseViews(const std::vector<RangeView>& input,
+                                               const algo::Rig& rig,
+                                               const std::vector<std::optional<Pose>>& givenPoses,
+                                               const FuseOptions& options) {
+  open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
+  std::vector<RangeView> views = viewsForFusion(input, rig, options);
   FuseReport report;
   const auto failWith = [&report](std::string message) {
     return std::unexpected(FuseError{std::move(message), report});

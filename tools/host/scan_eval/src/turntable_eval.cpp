@@ -16,8 +16,6 @@
 #include "smx/algo/range_image.hpp"
 #include "smx/eval/sim_frame.hpp"
 #include "smx/scan/fuse.hpp"
-#include "smx/scan/range_clean.hpp"
-#include "smx/scan/table_crop.hpp"
 #include "smx/text/printf_text.hpp"
 #include "truth_surface.hpp"
 
@@ -50,10 +48,15 @@ const sim::TurntableMount& mountOf(const sim::Scene& scene) {
   return *scene.turntable;
 }
 
+// The turntable's rotation by `deg`.
+Eigen::Matrix3d turn(const sim::TurntableMount& mount, double deg) {
+  return Eigen::Matrix3d(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+}
+
 // The scene with its table turned by `deg`: objects on it are turned about the table's line.
 sim::Scene turned(const sim::Scene& scene, double deg) {
   const auto& mount = mountOf(scene);
-  const Eigen::Matrix3d q(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
+  const Eigen::Matrix3d q = turn(mount, deg);
   sim::Scene out = scene;
   for (auto& object : out.objects) {
     if (object.onTurntable) {
@@ -82,13 +85,9 @@ open3d::geometry::TriangleMesh trueSurface(const sim::Scene& scene, bool scanned
 struct Projected {
   int x = 0;
   int y = 0;
-  Vec3 device = Vec3::Zero();  // the point in the camera's frame
+  Vec3 world = Vec3::Zero();   // the point with the table turned
+  Vec3 device = Vec3::Zero();  // the same in the camera's frame
 };
-
-// The turntable's rotation by `deg`.
-Eigen::Matrix3d turn(const sim::TurntableMount& mount, double deg) {
-  return Eigen::Matrix3d(Eigen::AngleAxisd(deg * kRadPerDeg, mount.axis.normalized()));
-}
 
 Vec3 inDevice(const algo::Camera& camera, const Vec3& w) {
   const auto d = lens::toDevice(camera, {w.x(), w.y(), w.z()});
@@ -108,7 +107,7 @@ std::optional<Projected> project(const algo::Camera& camera, const sim::Turntabl
   if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
     return std::nullopt;
   }
-  return Projected{.x = x, .y = y, .device = inDevice(camera, w)};
+  return Projected{.x = x, .y = y, .world = w, .device = inDevice(camera, w)};
 }
 
 // For each sample (model frame, with its normal) that camera `camera` sees lit in `frame`,
@@ -120,8 +119,7 @@ void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scen
   const auto& mount = mountOf(scene);
   const Eigen::Matrix3d q = turn(mount, deg);
   for (std::size_t i = 0; i < samples.points_.size(); ++i) {
-    const Vec3& p = samples.points_[i];
-    const auto at = project(device, mount, deg, p);
+    const auto at = project(device, mount, deg, samples.points_[i]);
     if (!at) {
       continue;
     }
@@ -133,8 +131,7 @@ void markVisible(const eval::SimFrame& frame, int camera, const sim::Scene& scen
     if (!lit || !std::isfinite(truth) || std::abs(at->device.z() - truth) >= kVisibleM) {
       continue;
     }
-    const Vec3 w = q * (p - mount.pivot) + mount.pivot;
-    const Vec3 normal = inDevice(device, w + q * samples.normals_[i]) - at->device;
+    const Vec3 normal = inDevice(device, at->world + q * samples.normals_[i]) - at->device;
     const double cos = std::abs(normal.normalized().dot(at->device.normalized()));
     bestCos[i] = std::max(bestCos[i], cos);
   }
@@ -285,11 +282,7 @@ TurntableEvalResult runTurntableEval(const TurntableEvalOptions& options) {
   const auto& covered = measured.covered;
 
   // Where the rest was lost: the views as decoded, and as the fusion took them.
-  std::vector<scan::RangeView> cleaned = views;
-  for (auto& view : cleaned) {
-    scan::keepOnTable(view, rig, *fuse.axis, fuse.tableRadiusM);
-    scan::cleanForFusion(view, rig, fuse.clean);
-  }
+  const std::vector<scan::RangeView> cleaned = scan::viewsForFusion(views, rig, fuse);
   std::size_t undecoded = 0;
   std::size_t removed = 0;
   std::size_t unmeshed = 0;

@@ -76,7 +76,14 @@ struct FuseError {
   FuseReport report{};  // as far as it got
 };
 
-// `givenPoses` is empty or one per view. Fewer than 2 views fused is an error.
+// What the model takes of each view: a turntable's views (every view with an angle, an axis and
+// a table radius given) only what turns with the table, and no view its edges or grazing pixels.
+[[nodiscard]] std::vector<RangeView> viewsForFusion(const std::vector<RangeView>& input,
+                                                    const algo::Rig& rig,
+                                                    const FuseOptions& options);
+
+// `givenPoses` is empty or one per view (the views as given; fuseViews takes viewsForFusion of
+// them). Fewer than 2 views fused is an error.
 [[nodiscard]] std::expected<FuseResult, FuseError> fuseViews(
     const std::vector<RangeView>& input, const algo::Rig& rig,
     const std::vector<std::optional<Pose>>& givenPoses, const FuseOptions& options = {});
