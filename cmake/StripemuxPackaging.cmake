@@ -69,6 +69,8 @@ set(CPACK_DEBIAN_STRIPEMUX_DESCRIPTION "stripemux host tool: patterns, simulatio
 evaluation, device client
 The stripemux command with the simulator's named scenes and the example boards and rigs
 (/usr/share/stripemux).")
+# The live view's 3D point cloud (three.js, served from this machine); the page works without.
+set(CPACK_DEBIAN_STRIPEMUX_PACKAGE_RECOMMENDS libjs-three)
 set(CPACK_DEBIAN_STRIPEMUXD_PACKAGE_NAME stripemuxd)
 set(CPACK_DEBIAN_STRIPEMUXD_DESCRIPTION "stripemux scanner firmware with a systemd unit
 stripemuxd serves range images of the board's cameras and projectors to a host. Boards are in

@@ -33,6 +33,7 @@ int runCli(std::span<const std::string> args, const CliStreams& io) {
   addTurntableCommand(app, io, exitCode);
   addFuseCommand(app, io, exitCode);
   addScanCommand(app, io, exitCode);
+  addViewCommand(app, io, exitCode);
 
   std::vector<const char*> argv{"stripemux"};
   for (const auto& a : args) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "config_change.hpp"
 #include "config_presets.hpp"
 #include "device_client.hpp"
 #include "device_option.hpp"
@@ -33,72 +34,8 @@ struct ConfigOptions {
   std::string source;               // apply FILE|PRESET
 };
 
-struct Failure {
-  int code;
-  std::string message;
-};
+using Failure = ConfigChangeFailure;
 using Result = std::expected<std::string, Failure>;
-
-bool isSettingKey(std::string_view key) {
-  const auto keys = config::deviceConfigKeys();
-  return std::ranges::find(keys, key) != keys.end();
-}
-
-std::string settingKeysList() {
-  std::string list;
-  for (const auto key : config::deviceConfigKeys()) {
-    list += (list.empty() ? "" : ", ") + std::string(key);
-  }
-  return list;
-}
-
-Json projectorList(const std::string& ids) {
-  Json list = Json::array();
-  std::size_t from = 0;
-  while (from <= ids.size()) {
-    const std::size_t comma = std::min(ids.find(',', from), ids.size());
-    list.push_back(ids.substr(from, comma - from));
-    from = comma + 1;
-  }
-  return list;
-}
-
-// KEY=VALUE… as a stripemux-config/1 change. A value is JSON when it reads as JSON (numbers),
-// else a word (compression=rvl); projectors=ID,ID is a list; rig=FILE embeds that rig.json. The
-// device checks the values.
-std::expected<std::string, Failure> changeFromAssignments(const std::vector<std::string>& assign) {
-  Json doc = Json::object();
-  doc["format"] = config::kDeviceConfigFormat;
-  for (const std::string& item : assign) {
-    const auto eq = item.find('=');
-    const std::string key = item.substr(0, eq);
-    if (eq == std::string::npos || eq + 1 == item.size()) {
-      return std::unexpected(
-          Failure{kExitUsage, "set: expected KEY=VALUE, got \"" + printable(item) + "\""});
-    }
-    if (!isSettingKey(key)) {
-      return std::unexpected(Failure{kExitUsage, "set: no setting \"" + printable(key) +
-                                                     "\"; settings: " + settingKeysList()});
-    }
-    const std::string value = item.substr(eq + 1);
-    if (key == "rig") {
-      // Read and checked here, so that a broken file is named; the device checks it fits.
-      const auto rig = config::loadRig(value);
-      if (!rig) {
-        return std::unexpected(Failure{kExitBadInput, "set rig: " + rig.error().message()});
-      }
-      doc[key] = Json::parse(config::toJson(*rig));
-      continue;
-    }
-    const Json parsed = Json::parse(value, nullptr, false);
-    if (key == "projectors" && !parsed.is_array()) {
-      doc[key] = projectorList(value);  // projectors=proj0,proj2
-      continue;
-    }
-    doc[key] = parsed.is_discarded() ? Json(value) : parsed;
-  }
-  return doc.dump();
-}
 
 // apply FILE|PRESET: a path (it has a '/' or ends in .json) or a preset's name.
 std::expected<std::string, Failure> changeFromSource(const std::string& source) {

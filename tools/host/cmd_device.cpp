@@ -46,11 +46,6 @@ struct StreamOptions {
   bool confidence = false;
 };
 
-bool isLoopback(const std::string& address) {
-  return address.starts_with("127.") || address.starts_with("localhost") ||
-         address.starts_with("[::1]");
-}
-
 std::string describe(const DeviceInfo& info) {
   std::ostringstream s;
   s << "board " << printable(info.board) << ", firmware " << printable(info.firmwareVersion) << " ("

@@ -15,9 +15,13 @@
 #include "device_client.hpp"
 #include "device_option.hpp"
 #include "fuse_runner.hpp"
+#include "live_view.hpp"
 #include "scan_handheld.hpp"
+#include "scan_runner.hpp"
 #include "scan_turntable.hpp"
 #include "scan_views_writer.hpp"
+#include "smx/scan/fuse.hpp"
+#include "smx/scan/table_crop.hpp"
 #include "smx/text/printf_text.hpp"
 #include "terminal_text.hpp"
 
@@ -25,18 +29,6 @@ namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct ScanOptions {
-  std::string device;
-  fs::path out;
-  bool turntable = false;
-  int views = 24;
-  bool handheld = false;
-  int frames = 0;
-  bool noColour = false;
-  double timeoutS = 10;
-  FuseFolderOptions fuse;
-};
 
 int fail(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux scan: " << printable(message) << "\n";
@@ -59,7 +51,46 @@ std::string noTurntable(const std::string& why) {
   return why + ": scan the object by hand (--handheld) or on a device with a turntable";
 }
 
-int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
+constexpr double kLiveModelVoxelM = 0.002;
+
+// A view's points in the rig's frame, with colour when the view has it (no normals: the page
+// draws points only).
+scan::Cloud viewPoints(const DeviceInfo& info, const scan::RangeView& view) {
+  scan::Cloud cloud;
+  for (std::size_t c = 0; c < view.cameras.size() && c < info.rig.cameras.size(); ++c) {
+    scan::append(cloud, scan::cameraPoints(info.rig.cameras[c], view.cameras[c], view.depthUnitM));
+  }
+  return scan::downsampled(cloud, kLiveModelVoxelM);
+}
+
+nlohmann::json scanStatus(std::string_view mode, std::string_view state, const fs::path& out,
+                          const view::SidesSeen& sides, const scan::Cloud& model) {
+  return {{"mode", mode},
+          {"state", state},
+          {"out", out.string()},
+          {"coverage_pct", sides.percent()},
+          {"model_points", model.size()}};
+}
+
+// Fuses and meshes the scan's folder; the page says so while it runs and how it ended.
+int fuseForPage(const FuseFolderOptions& fuse, const CliStreams& io, LiveView* live,
+                nlohmann::json status) {
+  if (live != nullptr) {
+    live->setScan(status);
+    live->refresh();
+  }
+  const int code = runFuseFolder(fuse, io, "stripemux scan");
+  if (live != nullptr) {
+    status["state"] = code == kExitOk ? "done" : "failed";
+    live->setScan(status);
+    live->setMessage(code == kExitOk ? "model written to " + fuse.out
+                                     : "the scan could not be fused: see the terminal");
+    live->refresh();
+  }
+  return code;
+}
+
+int runTurntableScan(const ScanOptions& opts, const CliStreams& io, LiveView* live) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
@@ -90,16 +121,45 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
          << info.cameras << " cameras; " << opts.views << " views into "
          << (opts.out / "views").string() << "\n";
   const auto start = std::chrono::steady_clock::now();
-  auto views =
-      captureTurntableViews(*client, capture,
-                            [&](const scan::RangeView& view,
-                                const TurntableStep& step) -> std::expected<void, std::string> {
-                              if (auto ok = writer->add(view); !ok) {
-                                return ok;
-                              }
-                              io.out << progressLine(step) << "\n" << std::flush;
-                              return {};
-                            });
+  const scan::TurntableAxis axis{
+      Eigen::Vector3d(info.rig.turntable->axis[0], info.rig.turntable->axis[1],
+                      info.rig.turntable->axis[2])
+          .normalized(),
+      Eigen::Vector3d(info.rig.turntable->point[0], info.rig.turntable->point[1],
+                      info.rig.turntable->point[2])};
+  scan::Cloud model;  // the live view's: each view placed by the table's angle
+  view::SidesSeen sides;
+  if (live != nullptr) {
+    live->setDevice(info, {});
+    live->setScan(scanStatus("turntable", "turning", opts.out, sides, model));
+    live->refresh();
+  }
+  auto views = captureTurntableViews(
+      *client, capture,
+      [&](const scan::RangeView& view,
+          const TurntableStep& step) -> std::expected<void, std::string> {
+        if (auto ok = writer->add(view); !ok) {
+          return ok;
+        }
+        io.out << progressLine(step) << "\n" << std::flush;
+        if (live != nullptr) {
+          live->view(view);
+          // As fusion does: only what stands on the table turns with it.
+          scan::RangeView onTable = view;
+          scan::keepOnTable(onTable, info.rig, axis, opts.fuse.tableRadiusMm * 1e-3);
+          scan::append(model, scan::transformed(viewPoints(info, onTable),
+                                                scan::turntablePose(axis, step.angleDeg)));
+          model = scan::downsampled(model, kLiveModelVoxelM);
+          sides.add(step.angleDeg);
+          live->model(model);
+          auto status = scanStatus("turntable", "turning", opts.out, sides, model);
+          status["views"] = step.views;
+          status["views_done"] = step.view + 1;
+          live->setScan(status);
+          live->refresh();
+        }
+        return {};
+      });
   if (!views) {
     const bool absent = views.error().starts_with("the device has no turntable");
     return fail(io, absent ? kExitBadInput : kExitDeviceOrIo, views.error());
@@ -114,7 +174,7 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io) {
   FuseFolderOptions fuse = opts.fuse;
   fuse.dir = opts.out.string();
   fuse.out = opts.out.string();
-  return runFuseFolder(fuse, io, "stripemux scan");
+  return fuseForPage(fuse, io, live, scanStatus("turntable", "fusing", opts.out, sides, model));
 }
 
 // Ctrl-C ends a hand-held scan the way --frames does: the stream stops and the model is made.
@@ -133,7 +193,26 @@ const char* stateName(const scan::TrackResult& r) {
   return r.quality.good ? "tracking" : "weak";
 }
 
-int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
+// The sides of the model the fused captures saw: azimuths of the rig's centre about the model's
+// centroid, in the plane across the first capture's vertical (its y axis).
+view::SidesSeen sidesAround(const scan::Cloud& model, const std::vector<Eigen::Vector3d>& centres) {
+  view::SidesSeen sides;
+  if (model.empty()) {
+    return sides;
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : model.points) {
+    centroid += p;
+  }
+  centroid /= static_cast<double>(model.size());
+  for (const auto& c : centres) {
+    const Eigen::Vector3d d = c - centroid;
+    sides.add(std::atan2(d.x(), -d.z()) * 180.0 / std::numbers::pi);
+  }
+  return sides;
+}
+
+int runHandheldScan(const ScanOptions& opts, const CliStreams& io, LiveView* live) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
@@ -161,6 +240,15 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
                                        .frameTimeout = secondsOption(opts.timeoutS)};
   int captures = 0;
   int fused = 0;
+  std::vector<Eigen::Vector3d> fusedCentres;  // the rig's centre at each fused capture
+  view::SidesSeen sides;
+  scan::Cloud model;
+  auto lastPage = std::chrono::steady_clock::now();
+  if (live != nullptr) {
+    live->setDevice(info, {.stopScan = true});
+    live->setScan(scanStatus("handheld", "starting", opts.out, sides, model));
+    live->refresh();
+  }
   auto tally = trackHandheld(
       *client, *tracker, capture, interrupted,
       [&](const scan::RangeView& view,
@@ -172,6 +260,29 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
             return ok;
           }
           poses.emplace_back(result.pose);
+          fusedCentres.emplace_back(result.pose.translation());
+        }
+        if (live != nullptr) {
+          live->view(view);
+          if (const auto now = std::chrono::steady_clock::now();
+              now - lastPage >= std::chrono::seconds(1)) {
+            lastPage = now;
+            model = tracker->model();
+            sides = sidesAround(model, fusedCentres);
+            live->model(model);
+            auto status = scanStatus("handheld", stateName(result), opts.out, sides, model);
+            status["captures"] = captures;
+            status["fused"] = fused;
+            status["lost"] = captures - fused;
+            status["quality"] = result.quality.score;
+            live->setScan(status);
+            live->refresh();
+          }
+          for (const view::Control& control : live->takeControls()) {
+            if (control.action == "stop-scan") {
+              interrupted.store(true);
+            }
+          }
         }
         // A line twice a second, and at once when tracking is lost or found again.
         const auto now = std::chrono::steady_clock::now();
@@ -218,10 +329,14 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io) {
                                   .relocalised = tally->relocalised,
                                   .trackMsMean = trackMs,
                                   .deviceFramesDropped = tally->device.framesDropped};
-  return runFuseFolder(fuse, io, "stripemux scan");
+  return fuseForPage(fuse, io, live, scanStatus("handheld", "fusing", opts.out, sides, model));
 }
 
 }  // namespace
+
+int runScan(const ScanOptions& opts, const CliStreams& io, LiveView* live) {
+  return opts.turntable ? runTurntableScan(opts, io, live) : runHandheldScan(opts, io, live);
+}
 
 void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   auto opts = std::make_shared<ScanOptions>();
@@ -251,12 +366,27 @@ void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
                   "Seconds to wait for each frame and status answer (default 10)")
       ->check(CLI::Range(0.1, 3600.0));
   addFuseOptions(*cmd, opts->fuse);
-  cmd->callback([opts, &io, &exitCode] {
+  auto liveView = std::make_shared<bool>(false);
+  auto page = std::make_shared<view::ServerOptions>();
+  auto* viewFlag =
+      cmd->add_flag("--view", *liveView, "Show the scan live in a browser (stripemux view's page)");
+  addPageOptions(*cmd, *page, "--view-", viewFlag);
+  cmd->callback([opts, liveView, page, &io, &exitCode] {
     if (!opts->turntable && !opts->handheld) {
       exitCode = fail(io, kExitUsage, "give --turntable or --handheld");
       return;
     }
-    exitCode = opts->turntable ? runTurntableScan(*opts, io) : runHandheldScan(*opts, io);
+    if (!*liveView) {
+      exitCode = runScan(*opts, io, nullptr);
+      return;
+    }
+    auto live = LiveView::start(*page);
+    if (!live) {
+      exitCode = fail(io, kExitDeviceOrIo, live.error());
+      return;
+    }
+    io.out << "live view: " << (*live)->url() << "\n" << std::flush;
+    exitCode = runScan(*opts, io, live->get());
   });
 }
 

@@ -26,5 +26,6 @@ void addFlashCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addTurntableCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addFuseCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode);
+void addViewCommand(CLI::App& app, const CliStreams& io, int& exitCode);
 
 }  // namespace smx::host

@@ -18,6 +18,13 @@ inline std::chrono::milliseconds secondsOption(double seconds) {
   return std::chrono::milliseconds(static_cast<std::int64_t>(seconds * 1000));
 }
 
+// A device on this machine shares the host's CLOCK_MONOTONIC, so capture → host latency can be
+// read from its timestamps.
+inline bool isLoopback(const std::string& address) {
+  return address.starts_with("127.") || address.starts_with("localhost") ||
+         address.starts_with("[::1]");
+}
+
 // A malformed HOST[:PORT] is a usage error (exit 1), found before any connection is tried.
 inline CLI::Validator deviceAddressValidator() {
   return {[](const std::string& text) {

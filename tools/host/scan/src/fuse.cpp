@@ -31,14 +31,6 @@ std::string fixed(double v, int decimals) {
   return text;
 }
 
-// The rig at table angle `deg` seen from the table at angle 0: the object turned by +deg about
-// the axis, so its points go back by −deg.
-Pose turntablePose(const TurntableAxis& axis, double deg) {
-  const double rad = -deg * std::numbers::pi / 180.0;
-  return Eigen::Translation3d(axis.point) * Eigen::AngleAxisd(rad, axis.direction.normalized()) *
-         Eigen::Translation3d(-axis.point);
-}
-
 // One registration between views: `source` onto `target`, in the rigs' frames.
 struct Edge {
   std::size_t source = 0;
@@ -215,6 +207,12 @@ class Fuser {
 };
 
 }  // namespace
+
+Pose turntablePose(const TurntableAxis& axis, double deg) {
+  const double rad = -deg * std::numbers::pi / 180.0;
+  return Eigen::Translation3d(axis.point) * Eigen::AngleAxisd(rad, axis.direction.normalized()) *
+         Eigen::Translation3d(-axis.point);
+}
 
 std::vector<RangeView> viewsForFusion(const std::vector<RangeView>& input, const algo::Rig& rig,
                                       const FuseOptions& options) {

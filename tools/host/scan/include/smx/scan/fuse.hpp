@@ -76,6 +76,10 @@ struct FuseError {
   FuseReport report{};  // as far as it got
 };
 
+// The rig at table angle `deg` seen from the table at angle 0: the object turned by +deg about
+// the axis, so its points go back by −deg.
+[[nodiscard]] Pose turntablePose(const TurntableAxis& axis, double deg);
+
 // What the model takes of each view: a turntable's views (every view with an angle, an axis and
 // a table radius given) only what turns with the table, and no view its edges or grazing pixels.
 [[nodiscard]] std::vector<RangeView> viewsForFusion(const std::vector<RangeView>& input,
