@@ -118,16 +118,7 @@ void LiveView::setDevice(const DeviceInfo& info, const LiveControls& controls) {
                       {"fps", info.fps},
                       {"depth_unit_m", info.depthUnitM}}},
                     {"cameras", cameras},
-                    {"presets", presets},
-                    {"controls",
-                     {{"start", controls.stream},
-                      {"stop", controls.stream},
-                      {"preset", controls.presets},
-                      {"apply-preset", controls.presets},
-                      {"set-config", controls.presets},
-                      {"scan-turntable", controls.startScans},
-                      {"scan-handheld", controls.startScans},
-                      {"stop-scan", controls.stopScan}}}});
+                    {"presets", presets}});
 }
 
 void LiveView::setSettings(const std::string& document) {
@@ -262,7 +253,9 @@ void LiveView::refresh() {
       {"controls",
        {{"start", controls_.stream && !streaming_},
         {"stop", controls_.stream && streaming_},
+        {"preset", controls_.presets},
         {"apply-preset", controls_.presets},
+        {"config", controls_.presets},
         {"set-config", controls_.presets},
         {"scan-turntable", controls_.startScans},
         {"scan-handheld", controls_.startScans},

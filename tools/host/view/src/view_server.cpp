@@ -42,10 +42,6 @@ std::string readText(const std::string& path) {
   return in ? std::move(text).str() : std::string();
 }
 
-bool isLoopbackAddress(const asio::ip::address& a) {
-  return a.is_loopback();
-}
-
 // The page's controls as the server accepts them: anything else is refused with a reason.
 std::expected<Control, std::string> parseControl(const nlohmann::json& j) {
   const auto action = j.find("action");
@@ -424,7 +420,7 @@ std::expected<std::unique_ptr<ViewServer>, std::string> ViewServer::start(
                            std::to_string(options.port) + ": " + ec.message());
   }
   impl->port = impl->acceptor.local_endpoint().port();
-  impl->loopbackOnly = isLoopbackAddress(address);
+  impl->loopbackOnly = address.is_loopback();
   impl->threeJs = readText(options.threeDir + "/three.min.js");
   impl->orbitControls = readText(options.threeDir + "/examples/js/controls/OrbitControls.js");
   if (impl->orbitControls.empty()) {

@@ -331,9 +331,6 @@ function onSession(s) {
     o.value = p; o.textContent = p;
     select.appendChild(o);
   }
-  for (const [id, ok] of Object.entries(s.controls || {})) {
-    if ($(id)) $(id).disabled = !ok;
-  }
   if (typeof THREE === 'undefined') {
     $('cloud-note').textContent = 'No 3D view: three.js is not installed (Debian package libjs-three).';
     return;
