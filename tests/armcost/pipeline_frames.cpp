@@ -1,8 +1,8 @@
-// pipeline_frames --rig RIG.json --image FRAME.ppm --frames N [--until STAGE]: one camera's
-// pipeline, set up as the firmware sets it up (Device::create), run N times on one frame. Built
-// for every preset; tests/armcost/count-instructions runs the aarch64 build under qemu-user with
-// an instruction-counting plugin and subtracts a --frames 0 run, which does all the same set-up
-// and no frame (docs/arm-cost.md). --until stops each frame after a stage, for the split:
+// pipeline_frames --rig RIG.json --image FRAME.ppm --frames N [--until STAGE] [--reference]: one
+// camera's pipeline, set up as the firmware sets it up (Device::create), run N times on one frame.
+// Built for every preset; tests/armcost/count-instructions runs the aarch64 build under qemu-user
+// with an instruction-counting plugin and subtracts a --frames 0 run, which does all the same
+// set-up and no frame (docs/arm-cost.md). --until stops each frame after a stage, for the split:
 // demux, decode, triangulate, merge (the whole pipeline: CameraPipeline::run, the default) or
 // send (merge, then the range frame encoded for the wire with RVL, as while streaming).
 // Exit codes: 0 ok, 1 usage, 2 rejected rig or image, 3 the pipeline failed.
@@ -39,6 +39,7 @@ struct Options {
   std::string image;
   int frames = 1;
   Stage until = Stage::kMerge;
+  bool reference = false;
 };
 
 // Pixels with a result, counted without branches so that a run of 0 frames (over zeroed planes)
@@ -128,6 +129,7 @@ int run(const Options& opts) {
     std::fprintf(stderr, "pipeline_frames: %s\n", pipeline.error().message);
     return kExitPipeline;
   }
+  pipeline->useReferenceKernels(opts.reference);
   // The send queue's slot size (Device's constructor); fixed header fields keep runs identical.
   std::vector<std::byte> wire(protocol::rangeFrameBound(camera.width, camera.height));
   const protocol::RangeFrameHeader header{
@@ -199,6 +201,8 @@ int parseAndRun(int argc, char** argv) {
                  "Last stage of each frame: demux, decode, triangulate, merge "
                  "(the whole pipeline, default) or send (merge + RVL encoding)")
       ->check(CLI::IsMember({"demux", "decode", "triangulate", "merge", "send"}));
+  app.add_flag("--reference", opts.reference,
+               "Every stage after demultiplexing as its plain scalar definition, not its schedule");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

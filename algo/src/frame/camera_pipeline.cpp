@@ -121,6 +121,13 @@ Result<CameraPipeline> CameraPipeline::create(const CameraPipelineSetup& setup, 
   return c;
 }
 
+void CameraPipeline::useReferenceKernels(bool on) {
+  reference_ = on;
+  if (decoder_) {
+    decoder_->useReferenceKernels(on);
+  }
+}
+
 // The stages check that create() set their objects (it always does; a pipeline exists only
 // after it), which also keeps every optional access visibly checked.
 Result<void> CameraPipeline::demultiplex(ConstRgbView image) {
@@ -167,7 +174,8 @@ Result<void> CameraPipeline::triangulate() {
     if (auto ok = trustDepth(*triangulator, stripes_[i], merged_, confidences_[i], trust_); !ok) {
       return ok;
     }
-    if (auto ok = removeDepthEdges(merged_, depths_[i], edgeJumpPermille_); !ok) {
+    const auto edges = reference_ ? removeDepthEdgesReference : removeDepthEdges;
+    if (auto ok = edges(merged_, depths_[i], edgeJumpPermille_); !ok) {
       return ok;
     }
   }
@@ -182,9 +190,12 @@ Result<void> CameraPipeline::merge() {
     confidences[i] = confidences_[i];
   }
   const auto n = static_cast<std::size_t>(layout_.projectors);
-  auto merged = mergeRanges(std::span<const ConstDepthPlane>(inputs.data(), n),
-                            std::span<const ImageView<const std::uint8_t>>(confidences.data(), n),
-                            merged_, mergedConfidence_, trust_.tolerance);
+  const std::span<const ConstDepthPlane> ranges(inputs.data(), n);
+  const std::span<const ImageView<const std::uint8_t>> rangeConfidences(confidences.data(), n);
+  auto merged = reference_ ? mergeRangesReference(ranges, rangeConfidences, merged_,
+                                                  mergedConfidence_, trust_.tolerance)
+                           : mergeRanges(ranges, rangeConfidences, merged_, mergedConfidence_,
+                                         trust_.tolerance);
   if (merged && !window_.keepsAll()) {
     applyDepthWindow(merged_, mergedConfidence_, window_);
   }

@@ -1,9 +1,11 @@
 // The median-variant merge (range_merge.hpp; paper §4.2, "data merging stage": the ranges of
-// the separated patterns merged per image). This scalar code is the reference; no separate
-// schedule exists.
+// the separated patterns merged per image). merge<true> is the plain scalar definition,
+// merge<false> the schedule: the same sets, the median found by selection instead of sorting.
 #include "smx/algo/range_merge.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace smx::algo {
@@ -33,7 +35,7 @@ int compareVariance(const Set& a, const Set& b) {
 }
 
 // Median of v[0 … n), n ≥ 1, sorting it in place (insertion sort: n ≤ 72, usually ≤ 18).
-std::uint16_t median(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
+std::uint16_t medianBySorting(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
   for (std::size_t i = 1; i < n; ++i) {
     const std::uint16_t x = v[i];
     std::size_t j = i;
@@ -48,6 +50,20 @@ std::uint16_t median(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
     return v[mid];
   }
   return static_cast<std::uint16_t>((std::uint32_t{v[mid - 1]} + v[mid] + 1) / 2);
+}
+
+// The same median by selection: the middle value in place, and for an even count the largest
+// value below it, as sorting would leave them.
+std::uint16_t medianBySelection(std::array<std::uint16_t, kMaxValues>& v, std::size_t n) {
+  const std::size_t mid = n / 2;
+  std::uint16_t* const first = v.data();
+  std::uint16_t* const middle = first + mid;
+  std::nth_element(first, middle, first + n);
+  if (n % 2 == 1) {
+    return *middle;
+  }
+  const std::uint16_t below = *std::max_element(first, middle);
+  return static_cast<std::uint16_t>((std::uint32_t{below} + *middle + 1) / 2);
 }
 
 // 256 / √k, rounded: the predicted error of the mean of k agreeing ranges (Q8), k = 0…8.
@@ -97,6 +113,7 @@ std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std
   return 2 * bestSupport > present ? best : kNoDepth;
 }
 
+template <bool kReference>
 Result<void> merge(std::span<const ConstDepthPlane> ranges,
                    std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
                    ImageView<std::uint8_t>* outConfidence, const DepthTolerance& tolerance) {
@@ -127,8 +144,9 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
     }
   }
   const std::size_t n = ranges.size();
-  // The chosen members are gathered at the front of `chosen`; each new set is gathered behind
-  // them in `next`, and copied in when the fold keeps it (alone or in a union).
+  // The chosen members are gathered at the front of `chosen`. The reference gathers each new
+  // set in `next` and copies it in when the fold keeps it (alone or in a union); the schedule
+  // gathers it right behind the chosen members, where a union already has it.
   std::array<std::uint16_t, kMaxValues> chosen{};
   std::array<std::uint16_t, kWindow> next{};
   std::array<std::uint16_t, kMaxRanges> centre{};
@@ -142,8 +160,13 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
       if (oc != nullptr) {
         oc[x] = 0;
       }
+      std::uint32_t any = 0;
       for (std::size_t i = 0; i < n; ++i) {
         centre[i] = ranges[i].rowPtr(y)[x];
+        any |= centre[i];
+      }
+      if (!kReference && any == kNoDepth) {
+        continue;
       }
       const std::uint16_t ref = reference(centre, n, tolerance);
       if (ref == kNoDepth) {
@@ -171,13 +194,15 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
           ++agreeing;
         }
         const ConstDepthPlane& r = ranges[i];
+        std::uint16_t* gathered =
+            kReference ? next.data() : chosen.data() + static_cast<std::size_t>(best.count);
         Set set;
         for (int yy = y0; yy <= y1; ++yy) {
           const std::uint16_t* row = r.rowPtr(yy);
           for (int xx = x0; xx <= x1; ++xx) {
             const std::uint16_t z = row[xx];
             if (agrees(z)) {
-              next[static_cast<std::size_t>(set.count++)] = z;
+              gathered[set.count++] = z;
               set.sum += z;
               set.sumSquares += std::int64_t{z} * z;
             }
@@ -198,14 +223,18 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
           continue;
         }
         const auto at = static_cast<std::size_t>(keep == 0 ? best.count : 0);
-        for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
-          chosen[at + k] = next[k];
+        if (gathered != chosen.data() + at) {
+          // Ascending: where the schedule moves a set to the front, the ranges may overlap.
+          for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
+            chosen[at + k] = gathered[k];
+          }
         }
         best = keep == 0 ? Set{best.count + set.count, best.sum + set.sum,
                                best.sumSquares + set.sumSquares}
                          : set;
       }
-      o[x] = median(chosen, static_cast<std::size_t>(best.count));
+      const auto count = static_cast<std::size_t>(best.count);
+      o[x] = kReference ? medianBySorting(chosen, count) : medianBySelection(chosen, count);
       if (oc != nullptr) {
         const std::int32_t e =
             (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
@@ -220,13 +249,20 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
 
 Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out,
                          const DepthTolerance& tolerance) {
-  return merge(ranges, {}, out, nullptr, tolerance);
+  return merge<false>(ranges, {}, out, nullptr, tolerance);
 }
 
 Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges,
                          std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
                          ImageView<std::uint8_t> outConfidence, const DepthTolerance& tolerance) {
-  return merge(ranges, confidences, out, &outConfidence, tolerance);
+  return merge<false>(ranges, confidences, out, &outConfidence, tolerance);
+}
+
+Result<void> mergeRangesReference(std::span<const ConstDepthPlane> ranges,
+                                  std::span<const ImageView<const std::uint8_t>> confidences,
+                                  DepthPlane out, ImageView<std::uint8_t> outConfidence,
+                                  const DepthTolerance& tolerance) {
+  return merge<true>(ranges, confidences, out, &outConfidence, tolerance);
 }
 
 }  // namespace smx::algo

@@ -1,6 +1,7 @@
 // Multi-layer decoding (stripe_decode.hpp; paper §4.1–4.2: the colour-stripe permutation code
 // matched along the separated boundaries, multi-layer decoding after its [31]). This scalar code
-// is the reference; no separate schedule exists. Numerics:
+// is the reference; where a step has a faster schedule, the same template holds both
+// (kReference), the schedule only passing over work whose result is known. Numerics:
 //   Positions  Q8 pixels (int32); a boundary lies at its pixel centre + offset (Q8) along the
 //              encoding direction of that pixel, whose unit vector is Q1.14 (demux::UnitTable);
 //              the shift offset·u is rounded half up to Q8 once per frame (|shift| ≤ 128).
@@ -13,51 +14,77 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 
+#include "decode/decode_geometry.hpp"
 #include "demux_kernels.hpp"
 #include "smx/algo/stripe_code.hpp"
 
 namespace smx::algo {
 
+using decode::along;
+using decode::flat;
+using decode::Hit;
+using decode::kNone;
+using decode::packedX;
+using decode::packedY;
+using decode::PointQ8;
+using decode::Unit;
+using decode::unitOf;
+using decode::walk;
+using decode::walkSkippingEmpty;
+
 namespace {
 
 constexpr int kChainEachWay = stripe::kWindowTransitions - 1;  // 5: every window holding a pixel
-constexpr std::int32_t kNone = -1;
 
-struct PointQ8 {
-  std::int32_t x;
-  std::int32_t y;
-};
-
-struct Unit {
-  std::int32_t x;  // Q1.14
-  std::int32_t y;
-};
-
-Unit unitOf(const demux::UnitTable& units, std::uint16_t angle) {
-  return {units.cosOf(angle), units.sinOf(angle)};
+// The level most windows found and its count (the first of equals); only a strict majority is
+// used.
+std::pair<int, int> mostFound(const std::array<std::int16_t, stripe::kWindowTransitions>& found,
+                              int count) {
+  int best = 0;
+  int bestVotes = 0;
+  for (int a = 0; a < count; ++a) {
+    int n = 0;
+    for (int c = 0; c < count; ++c) {
+      n += found[static_cast<std::size_t>(c)] == found[static_cast<std::size_t>(a)] ? 1 : 0;
+    }
+    if (n > bestVotes) {
+      best = found[static_cast<std::size_t>(a)];
+      bestVotes = n;
+    }
+  }
+  return {best, bestVotes};
 }
 
-// (to − from) · u in Q8 pixels.
-std::int32_t along(PointQ8 from, PointQ8 to, Unit u) {
-  const std::int64_t dot = std::int64_t{to.x - from.x} * u.x + std::int64_t{to.y - from.y} * u.y;
-  return static_cast<std::int32_t>(dot >> 14);
+// The same where it matters, in two passes: a strict majority is unique, and Boyer–Moore's
+// candidate is it when there is one; otherwise its count is no majority either.
+std::pair<int, int> majorityFound(const std::array<std::int16_t, stripe::kWindowTransitions>& found,
+                                  int count) {
+  int candidate = 0;
+  int weight = 0;
+  for (int a = 0; a < count; ++a) {
+    const int level = found[static_cast<std::size_t>(a)];
+    if (weight == 0) {
+      candidate = level;
+    }
+    weight += level == candidate ? 1 : -1;
+  }
+  int votes = 0;
+  for (int a = 0; a < count; ++a) {
+    votes += found[static_cast<std::size_t>(a)] == candidate ? 1 : 0;
+  }
+  return {candidate, votes};
 }
 
-// Index of (x, y) in the decoder's unpadded per-pixel planes.
-constexpr std::size_t flat(int x, int y, int width) {
-  return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-         static_cast<std::size_t>(x);
-}
-
-constexpr std::int32_t pack(int x, int y) {
-  return (y << 16) | x;
-}
-constexpr int packedX(std::int32_t p) {
-  return p & 0xFFFF;
-}
-constexpr int packedY(std::int32_t p) {
-  return p >> 16;
+// Bit k set where chain[k] (lo ≤ k ≤ hi) is a plus transition.
+unsigned plusBitsOf(const std::array<stripe::Transition, 2 * kChainEachWay + 1>& chain, int lo,
+                    int hi) {
+  unsigned bits = 0;
+  for (int k = lo; k <= hi; ++k) {
+    bits |= stripe::isPlus(chain[static_cast<std::size_t>(k)]) ? 1U << k : 0U;
+  }
+  return bits;
 }
 
 Result<void> validate(int width, int height, const DecodeParams& p) {
@@ -152,11 +179,27 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   }
   stats_ = DecodeStats{};
   prepare(boundaries, directions);
-  link(directions);
-  vote();
+  if (reference_) {
+    link<true>(directions);
+  } else {
+    link<false>(directions);
+  }
+  if (reference_) {
+    vote<true>();
+  } else {
+    vote<false>();
+  }
   joinCurves();
-  smoothPositions(directions);
-  fill(directions, stripe);
+  if (reference_) {
+    smoothPositions<true>(directions);
+  } else {
+    smoothPositions<false>(directions);
+  }
+  if (reference_) {
+    fill<true>(directions, stripe);
+  } else {
+    fill<false>(directions, stripe);
+  }
   return {};
 }
 
@@ -181,64 +224,10 @@ void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
   }
 }
 
-namespace {
-
-// Half-pixel steps from `start` along (sx, sy) (Q8 per step), steps first…last; at each step the
-// 2×2 pixels around the sample are looked at (a 1-pixel-thick oblique curve can pass between
-// nearest-pixel samples), each 2×2 block once. `distance(x, y, i)` returns where the boundary
-// at that pixel lies along the walk (Q8), or −1 to pass it over; the nearest accepted pixel of
-// the first block that has one wins, packed (y << 16 | x) with its distance, else kNone.
-struct Hit {
-  std::int32_t at;
-  std::int32_t distance;
-};
-
-template <class Distance>
-Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start, std::int32_t sx,
-         std::int32_t sy, int first, int last, Distance distance) {
-  int lastX0 = -2;
-  int lastY0 = -2;
-  for (int k = first; k <= last; ++k) {
-    const int x0 = (start.x + k * sx) >> 8;
-    const int y0 = (start.y + k * sy) >> 8;
-    if (x0 < -1 || y0 < -1 || x0 >= width || y0 >= height) {
-      return {kNone, 0};
-    }
-    if (x0 == lastX0 && y0 == lastY0) {
-      continue;
-    }
-    lastX0 = x0;
-    lastY0 = y0;
-    std::int32_t best = kNone;
-    std::int32_t bestDistance = 0;
-    for (int qy = y0; qy <= y0 + 1; ++qy) {
-      for (int qx = x0; qx <= x0 + 1; ++qx) {
-        if (qx < 0 || qy < 0 || qx >= width || qy >= height) {
-          continue;
-        }
-        const std::int32_t i = qy * width + qx;
-        if (code[static_cast<std::size_t>(i)] == 0) {
-          continue;
-        }
-        const std::int32_t dist = distance(qx, qy, i);
-        if (dist >= 0 && (best == kNone || dist < bestDistance)) {
-          best = pack(qx, qy);
-          bestDistance = dist;
-        }
-      }
-    }
-    if (best != kNone) {
-      return {best, bestDistance};
-    }
-  }
-  return {kNone, 0};
-}
-
-}  // namespace
-
 // Step 1. From the boundary's sub-pixel position, half-pixel steps along ±axis; the first pixel
 // holding a boundary of another class at least minSeparation along the axis is the link
 // (boundaries of the same class met first are the same curve seen on a staircase).
+template <bool kReference>
 void StripeDecoder::link(ConstDirectionPlane d) {
   const demux::UnitTable& units = units_[0];
   const int steps = 2 * params_.maxGapPx;
@@ -263,8 +252,11 @@ void StripeDecoder::link(ConstDirectionPlane d) {
           const std::int32_t dist = sign * along(p, qp, u);
           return dist >= params_.minSeparationQ8 ? dist : -1;
         };
-        const Hit hit = walk(code_, width_, height_, p, sign * (u.x >> 7), sign * (u.y >> 7), 1,
-                             steps, distance);
+        const std::int32_t sx = sign * (u.x >> 7);
+        const std::int32_t sy = sign * (u.y >> 7);
+        const Hit hit =
+            kReference ? walk(code_, width_, height_, p, sx, sy, 1, steps, distance)
+                       : walkSkippingEmpty(code_, width_, height_, p, sx, sy, 1, steps, distance);
         (sign > 0 ? next_ : prev_)[i] = hit.at;
         // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
         (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
@@ -275,6 +267,7 @@ void StripeDecoder::link(ConstDirectionPlane d) {
 
 // Step 2. The chain around each pixel (index kChainEachWay is the pixel itself), then every
 // window of 6 consecutive transitions in it.
+template <bool kReference>
 void StripeDecoder::vote() {
   const auto indexOf = [this](std::int32_t packed) {
     return flat(packedX(packed), packedY(packed), width_);
@@ -326,27 +319,25 @@ void StripeDecoder::vote() {
     // Windows start at j (chain index) with lo ≤ j, j + 5 ≤ hi, j ≤ kChainEachWay ≤ j + 5.
     std::array<std::int16_t, stripe::kWindowTransitions> found{};
     int count = 0;
+    // The schedule reads every window's code from one word of the chain's plus bits: the links
+    // above chained the colours, so no window can fail decodeWindow's chain check.
+    const unsigned plusBits = kReference ? 0U : plusBitsOf(chain, lo, hi);
     for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
-      const int index =
-          stripe::decodeWindow(std::span<const stripe::Transition, stripe::kWindowTransitions>(
-              chain.data() + j, stripe::kWindowTransitions));
+      const auto window =
+          static_cast<int>((plusBits >> j) & ((1U << stripe::kWindowTransitions) - 1));
+      const int index = kReference
+                            ? stripe::decodeWindow(
+                                  std::span<const stripe::Transition, stripe::kWindowTransitions>(
+                                      chain.data() + j, stripe::kWindowTransitions))
+                            : stripe::kWindowIndex[static_cast<std::size_t>(stripe::windowCode(
+                                  stripe::from(chain[static_cast<std::size_t>(j)]), window))];
       if (index >= 0) {
         found[static_cast<std::size_t>(count++)] =
             static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
       }
     }
-    int best = 0;
-    int bestVotes = 0;
-    for (int a = 0; a < count; ++a) {
-      int n = 0;
-      for (int c = 0; c < count; ++c) {
-        n += found[static_cast<std::size_t>(c)] == found[static_cast<std::size_t>(a)] ? 1 : 0;
-      }
-      if (n > bestVotes) {
-        best = found[static_cast<std::size_t>(a)];
-        bestVotes = n;
-      }
-    }
+    const auto [best, bestVotes] =
+        kReference ? mostFound(found, count) : majorityFound(found, count);
     // A level only on a strict majority of the pixel's windows.
     if (2 * bestVotes > count) {
       own_[i] = static_cast<std::int16_t>(best);
@@ -492,10 +483,29 @@ void StripeDecoder::joinCurves() {
   }
 }
 
+// The schedule's step 3b for a pixel whose window lies inside the image, at the default radius:
+// the same terms in the same order, the window's offsets constants.
+template <int kRadius>
+void StripeDecoder::sumLevelAround(std::size_t i, Unit u, std::int32_t& sum,
+                                   std::int32_t& count) const {
+  const std::int16_t level = level_[i];
+  const auto w = static_cast<std::ptrdiff_t>(width_);
+  for (int dy = -kRadius; dy <= kRadius; ++dy) {
+    for (int dx = -kRadius; dx <= kRadius; ++dx) {
+      const auto q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(i) + dy * w + dx);
+      if (level_[q] == level) {
+        sum += along({0, 0}, {dx * 256 + shift_[q].x, dy * 256 + shift_[q].y}, u);
+        ++count;
+      }
+    }
+  }
+}
+
 // Step 3b. A decoded boundary's position along its axis becomes the mean over the pixels of the
 // same level within positionRadiusPx (the boundary is locally a line across the axis, so they
 // measure the same thing with independent noise). Means in Q8 (int32 sums of ≤ 81 terms), kept
 // in weight_ (free after step 3) until all are computed, then written back as shifts.
+template <bool kReference>
 void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
   const int r = params_.positionRadiusPx;
   if (r == 0) {
@@ -514,6 +524,12 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
       const PointQ8 centre{x * 256, y * 256};
       std::int32_t sum = 0;
       std::int32_t count = 0;
+      if (!kReference && r == kPositionRadius && x >= r && y >= r && x + r < width_ &&
+          y + r < height_) {
+        sumLevelAround<kPositionRadius>(i, u, sum, count);
+        weight_[i] = (sum >= 0 ? sum + count / 2 : sum - count / 2) / count;
+        continue;
+      }
       for (int qy = y > r ? y - r : 0; qy <= y + r && qy < height_; ++qy) {
         for (int qx = x > r ? x - r : 0; qx <= x + r && qx < width_; ++qx) {
           const std::size_t q = flat(qx, qy, width_);
@@ -541,8 +557,22 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
   }
 }
 
+// The schedule's pass-over for step 4: total_ (free after step 3) becomes the inclusive integral
+// image of the decoded boundary pixels (at most 8192² = 2^26 of them: int32).
+void StripeDecoder::integrateDecoded() {
+  for (int y = 0; y < height_; ++y) {
+    std::int32_t rowSum = 0;
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = flat(x, y, width_);
+      rowSum += level_[i] != 0 ? 1 : 0;
+      total_[i] = rowSum + (y > 0 ? total_[i - static_cast<std::size_t>(width_)] : 0);
+    }
+  }
+}
+
 // Step 4. Walk back along the pixel's own axis to the nearest boundary at or behind it; the
 // pixel lies between that boundary and its forward link when their levels are consecutive.
+template <bool kReference>
 void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
   const demux::UnitTable& units = units_[0];
   const int steps = 2 * params_.maxGapPx;
@@ -550,18 +580,44 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
     const Shift s = shift_[flat(x, y, width_)];
     return PointQ8{x * 256 + s.x, y * 256 + s.y};
   };
+  // The walk reaches at most maxGapPx + 1 pixels from its start along x and y.
+  const int reach = params_.maxGapPx + 1;
+  if constexpr (!kReference) {
+    integrateDecoded();
+  }
   for (int y = 0; y < height_; ++y) {
     StripeQ16* out = stripe.rowPtr(y);
     const std::uint16_t* dirs = d.rowPtr(y);
+    // The integral image's rows just above and at the bottom of the square (nullptr: above the
+    // image, all zero).
+    const int above = y - reach - 1;
+    const int below = y + reach < height_ ? y + reach : height_ - 1;
+    const std::int32_t* top = above >= 0 ? &total_[flat(0, above, width_)] : nullptr;
+    const std::int32_t* bottom = &total_[flat(0, below, width_)];
     for (int x = 0; x < width_; ++x) {
       out[x] = kNoStripe;
+      if constexpr (!kReference) {
+        // Decoded boundary pixels within `reach` of (x, y) along x and y.
+        const int left = x - reach - 1;
+        const int right = x + reach < width_ ? x + reach : width_ - 1;
+        std::int32_t near = bottom[right] - (left >= 0 ? bottom[left] : 0);
+        if (top != nullptr) {
+          near -= top[right] - (left >= 0 ? top[left] : 0);
+        }
+        if (near == 0) {
+          continue;  // whatever the walk meets, it is no decoded boundary
+        }
+      }
       const Unit u = unitOf(units, dirs[x]);
       const PointQ8 here{x * 256, y * 256};
       const auto behind = [&](int qx, int qy, std::int32_t) {
         return along(positionOf(qx, qy), here, u);
       };
+      const std::int32_t sx = -(u.x >> 7);
+      const std::int32_t sy = -(u.y >> 7);
       const std::int32_t q =
-          walk(code_, width_, height_, here, -(u.x >> 7), -(u.y >> 7), 0, steps, behind).at;
+          kReference ? walk(code_, width_, height_, here, sx, sy, 0, steps, behind).at
+                     : walkSkippingEmpty(code_, width_, height_, here, sx, sy, 0, steps, behind).at;
       if (q == kNone) {
         continue;
       }

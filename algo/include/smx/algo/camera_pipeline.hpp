@@ -71,6 +71,10 @@ class CameraPipeline {
   [[nodiscard]] Result<void> merge();
   [[nodiscard]] Result<void> run(ConstRgbView image);
 
+  // Every stage after demultiplexing as its plain scalar definition instead of its schedule:
+  // the same output bit for bit (PipelineSchedule.* compares them), for tests and benchmarks.
+  void useReferenceKernels(bool on);
+
   [[nodiscard]] int projectors() const { return layout_.projectors; }
   // create() sets every stage object: a CameraPipeline exists only after it.
   // NOLINTNEXTLINE(bugprone-unchecked-optional-access)
@@ -96,6 +100,7 @@ class CameraPipeline {
   int edgeJumpPermille_ = 0;
   DepthTrustParams trust_;
   DepthWindow window_;
+  bool reference_ = false;
   std::optional<Demultiplexer> demux_;
   std::optional<StripeDecoder> decoder_;
   std::array<std::optional<Triangulator>, kMaxProjectors> triangulators_;

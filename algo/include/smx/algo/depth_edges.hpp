@@ -17,4 +17,9 @@ namespace smx::algo {
 [[nodiscard]] Result<void> removeDepthEdges(ConstDepthPlane in, DepthPlane out,
                                             int maxJumpPermille);
 
+// The same as its plain scalar definition, which the schedule above must equal bit for bit
+// (PipelineSchedule.* compares them); for the tests and the benchmarks.
+[[nodiscard]] Result<void> removeDepthEdgesReference(ConstDepthPlane in, DepthPlane out,
+                                                     int maxJumpPermille);
+
 }  // namespace smx::algo

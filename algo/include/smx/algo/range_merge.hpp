@@ -54,4 +54,11 @@ inline constexpr int kMaxRanges = 8;
                                        DepthPlane out, ImageView<std::uint8_t> outConfidence,
                                        const DepthTolerance& tolerance = {});
 
+// The same as the plain scalar definition, which the schedule above must equal bit for bit
+// (PipelineSchedule.* compares them); for the tests and the benchmarks.
+[[nodiscard]] Result<void> mergeRangesReference(
+    std::span<const ConstDepthPlane> ranges,
+    std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
+    ImageView<std::uint8_t> outConfidence, const DepthTolerance& tolerance = {});
+
 }  // namespace smx::algo

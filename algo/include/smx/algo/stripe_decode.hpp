@@ -62,6 +62,9 @@ struct DecodeStats {
 namespace demux {
 class UnitTable;
 }  // namespace demux
+namespace decode {
+struct Unit;
+}  // namespace decode
 
 class StripeDecoder {
  public:
@@ -83,17 +86,32 @@ class StripeDecoder {
   }
   [[nodiscard]] const DecodeStats& stats() const { return stats_; }
 
+  // Every step as its plain scalar definition instead of its schedule: the same output bit for
+  // bit (DecodeSchedule.* compares them), for the tests and the benchmarks.
+  void useReferenceKernels(bool on) { reference_ = on; }
+
  private:
   StripeDecoder() = default;
   template <class Carver>
   [[nodiscard]] Result<void> carve(Carver& carver);
 
   void prepare(ConstBoundaryPlane b, ConstDirectionPlane d);
+  template <bool kReference>
   void link(ConstDirectionPlane d);
+  template <bool kReference>
   void vote();
   void joinCurves();
+  template <bool kReference>
   void smoothPositions(ConstDirectionPlane d);
+  void integrateDecoded();
+  [[nodiscard]] bool decodedWithin(int x, int y, int r) const;
+  template <bool kReference>
   void fill(ConstDirectionPlane d, StripePlane stripe);
+
+  // The default positionRadiusPx, which the schedule's step 3b unrolls.
+  static constexpr int kPositionRadius = 2;
+  template <int kRadius>
+  void sumLevelAround(std::size_t i, decode::Unit u, std::int32_t& sum, std::int32_t& count) const;
 
   // A boundary's position relative to its pixel centre, Q8 pixels.
   struct Shift {
@@ -105,6 +123,7 @@ class StripeDecoder {
   int height_ = 0;
   DecodeParams params_;
   DecodeStats stats_;
+  bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
   std::span<demux::UnitTable> units_;  // one table
   std::span<std::uint8_t> code_;       // Boundary::transition (0: none)
