@@ -1,6 +1,7 @@
 // The depth-edge filter (depth_edges.hpp; not in the paper: it removes depths across jumps).
 // filter<true> is the plain scalar definition; filter<false>, the schedule, looks at the eight
-// neighbours of a pixel inside the image without bounds checks and gives the same output.
+// neighbours of a pixel inside the image without bounds checks or a branch per value and gives
+// the same output.
 #include "smx/algo/depth_edges.hpp"
 
 #include <cstdint>
@@ -26,16 +27,23 @@ bool edgeAt(ConstDepthPlane in, int x, int y, std::int32_t z, std::int32_t limit
   return false;
 }
 
-// The same for a pixel whose 3 × 3 window lies inside the image: rows above, at and below it,
-// each pointing at the pixel's column.
-bool edgeInside(const std::uint16_t* above, const std::uint16_t* at, const std::uint16_t* below,
-                std::int32_t z, std::int32_t limit) {
-  const auto far = [z, limit](std::uint16_t v) {
-    const std::int32_t d = v - z;
-    return v != kNoDepth && 1000 * (d < 0 ? -d : d) > limit;
-  };
-  return far(above[-1]) || far(above[0]) || far(above[1]) || far(at[-1]) || far(at[1]) ||
-         far(below[-1]) || far(below[0]) || far(below[1]);
+// The same for the inner pixels x = 1 … w − 2 of an inner row, without a branch per value:
+// 1000 · |d| > limit is |d| > ⌊limit / 1000⌋ for integers, one unsigned comparison with z.
+void filterInnerRow(const std::uint16_t* above, const std::uint16_t* at, const std::uint16_t* below,
+                    std::uint16_t* out, int w, int maxJumpPermille) {
+  for (int x = 1; x + 1 < w; ++x) {
+    const std::int32_t z = at[x];
+    const std::int32_t t = maxJumpPermille * z / 1000;
+    const auto far = [z, t](std::uint16_t v) {
+      return static_cast<std::uint32_t>(v != kNoDepth) &
+             static_cast<std::uint32_t>(static_cast<std::uint32_t>(v - z + t) >
+                                        static_cast<std::uint32_t>(2 * t));
+    };
+    const std::uint32_t edge = far(above[x - 1]) | far(above[x]) | far(above[x + 1]) |
+                               far(at[x - 1]) | far(at[x + 1]) | far(below[x - 1]) | far(below[x]) |
+                               far(below[x + 1]);
+    out[x] = edge != 0 ? kNoDepth : static_cast<std::uint16_t>(z);
+  }
 }
 
 template <bool kReference>
@@ -51,18 +59,17 @@ Result<void> filter(ConstDepthPlane in, DepthPlane out, int maxJumpPermille) {
   for (int y = 0; y < h; ++y) {
     const std::uint16_t* row = in.rowPtr(y);
     std::uint16_t* o = out.rowPtr(y);
-    const bool innerRow = !kReference && y > 0 && y + 1 < h;
-    for (int x = 0; x < w; ++x) {
+    const bool innerRow = !kReference && maxJumpPermille > 0 && y > 0 && y + 1 < h && w > 2;
+    if (innerRow) {
+      filterInnerRow(in.rowPtr(y - 1), row, in.rowPtr(y + 1), o, w, maxJumpPermille);
+    }
+    for (int x = 0; x < w; x += innerRow && x == 0 ? w - 1 : 1) {
       const std::int32_t z = row[x];
       o[x] = static_cast<std::uint16_t>(z);
       if (z == kNoDepth || maxJumpPermille == 0) {
         continue;
       }
-      const std::int32_t limit = maxJumpPermille * z;
-      const bool edge = innerRow && x > 0 && x + 1 < w ? edgeInside(in.rowPtr(y - 1) + x, row + x,
-                                                                    in.rowPtr(y + 1) + x, z, limit)
-                                                       : edgeAt(in, x, y, z, limit);
-      o[x] = edge ? kNoDepth : static_cast<std::uint16_t>(z);
+      o[x] = edgeAt(in, x, y, z, maxJumpPermille * z) ? kNoDepth : static_cast<std::uint16_t>(z);
     }
   }
   return {};

@@ -189,7 +189,11 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   } else {
     vote<false>();
   }
-  joinCurves();
+  if (reference_) {
+    joinCurves<true>();
+  } else {
+    joinCurves<false>();
+  }
   if (reference_) {
     smoothPositions<true>(directions);
   } else {
@@ -349,6 +353,7 @@ void StripeDecoder::vote() {
 
 // Step 3. Union-find over touching boundary pixels of one class (parent = smaller index, path
 // halving), then a weighted Boyer–Moore majority per root and a second pass for its support.
+template <bool kReference>
 void StripeDecoder::joinCurves() {
   const auto find = [this](std::int32_t i) {
     while (parent_[static_cast<std::size_t>(i)] != i) {
@@ -396,6 +401,18 @@ void StripeDecoder::joinCurves() {
       }
     }
   }
+  // The schedule flattens the forest once: a parent has the smaller index, so in ascending
+  // order each parent already points at its root. Every later look-up is then one load.
+  if constexpr (!kReference) {
+    for (std::size_t i = 0; i < code_.size(); ++i) {
+      if (code_[i] != 0) {
+        parent_[i] = parent_[static_cast<std::size_t>(parent_[i])];
+      }
+    }
+  }
+  const auto rootOf = [&](std::size_t i) {
+    return static_cast<std::size_t>(kReference ? find(static_cast<std::int32_t>(i)) : parent_[i]);
+  };
   // Majority candidate per root, then its support among all votes of the curve.
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t i = 0; i < code_.size(); ++i) {
@@ -403,7 +420,7 @@ void StripeDecoder::joinCurves() {
       if (v == 0) {
         continue;
       }
-      const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+      const auto r = rootOf(i);
       if (pass == 0) {
         if (candidate_[r] == own_[i]) {
           weight_[r] += v;
@@ -429,7 +446,7 @@ void StripeDecoder::joinCurves() {
     if (code_[i] == 0) {
       continue;
     }
-    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    const auto r = rootOf(i);
     const bool majority = 2 * weight_[r] > total_[r] && weight_[r] >= params_.minCurveVotes;
     if (r == i && majority) {
       ++stats_.curves;
@@ -455,7 +472,7 @@ void StripeDecoder::joinCurves() {
     if (level == 0) {
       continue;
     }
-    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    const auto r = rootOf(i);
     const std::int32_t ahead = linkedLevel(next_[i]);
     const std::int32_t behind = linkedLevel(prev_[i]);
     bool aheadFits = ahead == level + 1;
@@ -473,7 +490,7 @@ void StripeDecoder::joinCurves() {
     if (level_[i] == 0) {
       continue;
     }
-    const auto r = static_cast<std::size_t>(find(static_cast<std::int32_t>(i)));
+    const auto r = rootOf(i);
     if (std::int64_t{100} * total_[r] >
         std::int64_t{params_.maxNeighbourDisagreePct} * (total_[r] + weight_[r])) {
       level_[i] = 0;
@@ -615,9 +632,10 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
       };
       const std::int32_t sx = -(u.x >> 7);
       const std::int32_t sy = -(u.y >> 7);
-      const std::int32_t q =
-          kReference ? walk(code_, width_, height_, here, sx, sy, 0, steps, behind).at
-                     : walkSkippingEmpty(code_, width_, height_, here, sx, sy, 0, steps, behind).at;
+      const Hit hit =
+          kReference ? walk(code_, width_, height_, here, sx, sy, 0, steps, behind)
+                     : walkSkippingEmpty(code_, width_, height_, here, sx, sy, 0, steps, behind);
+      const std::int32_t q = hit.at;
       if (q == kNone) {
         continue;
       }
@@ -629,7 +647,8 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
       if (level == 0 || n == kNone || level_[flat(packedX(n), packedY(n), width_)] != level + 1) {
         continue;
       }
-      const std::int32_t first = along(positionOf(qx, qy), here, u);
+      // The walk's distance to its hit is this one; the schedule does not compute it again.
+      const std::int32_t first = kReference ? along(positionOf(qx, qy), here, u) : hit.distance;
       const std::int32_t between = first - along(positionOf(packedX(n), packedY(n)), here, u);
       if (first >= between) {
         continue;  // the pixel lies beyond the forward link

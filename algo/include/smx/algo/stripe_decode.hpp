@@ -100,6 +100,7 @@ class StripeDecoder {
   void link(ConstDirectionPlane d);
   template <bool kReference>
   void vote();
+  template <bool kReference>
   void joinCurves();
   template <bool kReference>
   void smoothPositions(ConstDirectionPlane d);
