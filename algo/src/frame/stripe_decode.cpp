@@ -33,6 +33,7 @@ using decode::Unit;
 using decode::unitOf;
 using decode::walk;
 using decode::walkSkippingEmpty;
+using decode::walkTable;
 
 namespace {
 
@@ -117,6 +118,9 @@ Result<void> StripeDecoder::carve(Carver& carver) {
     }
   };
   step(carveSpan(carver, units_, 1));
+  const std::size_t walkSteps = 2 * static_cast<std::size_t>(params_.maxGapPx) + 1;
+  step(carveSpan(carver, fillBlocks_, demux::UnitTable::kEntries * walkSteps));
+  step(carveSpan(carver, fillBlockCount_, demux::UnitTable::kEntries));
   step(carveSpan(carver, code_, pixels));
   step(carveSpan(carver, shift_, pixels));
   step(carveSpan(carver, next_, pixels));
@@ -141,6 +145,7 @@ Result<std::size_t> StripeDecoder::workspaceBytes(int width, int height,
   StripeDecoder d;
   d.width_ = width;
   d.height_ = height;
+  d.params_ = params;
   ArenaSizer sizer;
   if (auto ok = d.carve(sizer); !ok) {
     return std::unexpected(ok.error());
@@ -163,6 +168,15 @@ Result<StripeDecoder> StripeDecoder::create(int width, int height, const DecodeP
     return std::unexpected(ok.error());
   }
   d.units_[0].fill();
+  // The fill's walks per direction entry e (angle 64 e: cosOf and sinOf read entries e, e − 256).
+  const int steps = 2 * params.maxGapPx;
+  const std::size_t perWalk = static_cast<std::size_t>(steps) + 1;
+  for (int e = 0; e < demux::UnitTable::kEntries; ++e) {
+    const Unit u = unitOf(d.units_[0], static_cast<std::uint16_t>(e * 64));
+    const auto row = d.fillBlocks_.subspan(static_cast<std::size_t>(e) * perWalk, perWalk);
+    d.fillBlockCount_[static_cast<std::size_t>(e)] =
+        static_cast<std::uint8_t>(decode::blockSteps(-(u.x >> 7), -(u.y >> 7), steps, row));
+  }
   for (auto& level : d.level_) {
     level = 0;
   }
@@ -286,6 +300,31 @@ void StripeDecoder::vote() {
     const std::int32_t back = links[from];
     return back != kNone && code_[indexOf(back)] == code_[to];
   };
+  const auto stepsBack = [&](std::size_t cur, std::size_t n) {
+    return stripe::to(kindAt(n)) == stripe::from(kindAt(cur)) && linksBack(next_, n, cur);
+  };
+  const auto stepsAhead = [&](std::size_t cur, std::size_t n) {
+    return stripe::from(kindAt(n)) == stripe::to(kindAt(cur)) && linksBack(prev_, n, cur);
+  };
+  // The schedule decides each pixel's two steps once, not once per chain through it: bit 0 the
+  // step behind, bit 1 the step ahead, in candidate_ (free until step 3 sets it).
+  if constexpr (!kReference) {
+    for (std::size_t i = 0; i < code_.size(); ++i) {
+      if (code_[i] == 0) {
+        continue;
+      }
+      const bool back = prev_[i] != kNone && stepsBack(i, indexOf(prev_[i]));
+      const bool ahead = next_[i] != kNone && stepsAhead(i, indexOf(next_[i]));
+      candidate_[i] = static_cast<std::int16_t>((back ? 1 : 0) | (ahead ? 2 : 0));
+    }
+  }
+  const auto chains = [&](std::size_t cur, std::size_t n, int bit) {
+    if constexpr (kReference) {
+      return bit == 1 ? stepsBack(cur, n) : stepsAhead(cur, n);
+    } else {
+      return (candidate_[cur] & bit) != 0;
+    }
+  };
   for (std::size_t i = 0; i < code_.size(); ++i) {
     own_[i] = 0;
     votes_[i] = 0;
@@ -301,7 +340,7 @@ void StripeDecoder::vote() {
         break;
       }
       const std::size_t n = indexOf(link);
-      if (stripe::to(kindAt(n)) != stripe::from(kindAt(cur)) || !linksBack(next_, n, cur)) {
+      if (!chains(cur, n, 1)) {
         break;
       }
       chain[static_cast<std::size_t>(--lo)] = kindAt(n);
@@ -314,7 +353,7 @@ void StripeDecoder::vote() {
         break;
       }
       const std::size_t n = indexOf(link);
-      if (stripe::from(kindAt(n)) != stripe::to(kindAt(cur)) || !linksBack(prev_, n, cur)) {
+      if (!chains(cur, n, 2)) {
         break;
       }
       chain[static_cast<std::size_t>(++hi)] = kindAt(n);
@@ -632,9 +671,16 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
       };
       const std::int32_t sx = -(u.x >> 7);
       const std::int32_t sy = -(u.y >> 7);
-      const Hit hit =
-          kReference ? walk(code_, width_, height_, here, sx, sy, 0, steps, behind)
-                     : walkSkippingEmpty(code_, width_, height_, here, sx, sy, 0, steps, behind);
+      Hit hit{};
+      if constexpr (kReference) {
+        hit = walk(code_, width_, height_, here, sx, sy, 0, steps, behind);
+      } else {
+        const std::size_t e = demux::UnitTable::entryOf(dirs[x]);
+        const auto blocks =
+            std::span<const decode::BlockStep>(fillBlocks_)
+                .subspan(e * (static_cast<std::size_t>(steps) + 1), fillBlockCount_[e]);
+        hit = walkTable(code_, width_, height_, x, y, sx, sy, steps, blocks, behind);
+      }
       const std::int32_t q = hit.at;
       if (q == kNone) {
         continue;

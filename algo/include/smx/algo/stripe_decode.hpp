@@ -64,6 +64,7 @@ class UnitTable;
 }  // namespace demux
 namespace decode {
 struct Unit;
+struct BlockStep;
 }  // namespace decode
 
 class StripeDecoder {
@@ -127,6 +128,9 @@ class StripeDecoder {
   bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
   std::span<demux::UnitTable> units_;  // one table
+  // The fill's walks per unit-table direction: blocks from stepsPerWalk() each, and how many.
+  std::span<decode::BlockStep> fillBlocks_;
+  std::span<std::uint8_t> fillBlockCount_;
   std::span<std::uint8_t> code_;       // Boundary::transition (0: none)
   std::span<Shift> shift_;             // where the boundary lies
   std::span<std::int32_t> next_;       // linked boundary ahead: y << 16 | x, or −1

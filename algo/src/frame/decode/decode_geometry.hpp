@@ -176,4 +176,65 @@ Hit walkSkippingEmpty(std::span<const std::uint8_t> code, int width, int height,
   return {kNone, 0};
 }
 
+// One block of a walk from a pixel centre, relative to that pixel. Walks from pixel centres in
+// one direction of the unit table visit the same blocks relative to their start (x · 256 is a
+// whole pixel, so ⌊(256 x + k s) / 256⌋ = x + ⌊k s / 256⌋): the fill's walks read them from a
+// table built once.
+struct BlockStep {
+  std::int8_t dx;
+  std::int8_t dy;
+};
+
+// The distinct blocks of the walk from (0, 0) along (sx, sy), steps 0…last, in order; returns
+// how many (at most last + 1).
+inline int blockSteps(std::int32_t sx, std::int32_t sy, int last, std::span<BlockStep> out) {
+  int count = 0;
+  for (int k = 0; k <= last; ++k) {
+    const auto dx = static_cast<std::int8_t>((k * sx) >> 8);
+    const auto dy = static_cast<std::int8_t>((k * sy) >> 8);
+    if (count > 0 && out[static_cast<std::size_t>(count - 1)].dx == dx &&
+        out[static_cast<std::size_t>(count - 1)].dy == dy) {
+      continue;
+    }
+    out[static_cast<std::size_t>(count++)] = {dx, dy};
+  }
+  return count;
+}
+
+// walk() from the centre of (x, y) along (sx, sy), steps 0…last, given its distinct blocks: the
+// same hit. When the first and last blocks lie inside the image so do all (they are monotone),
+// and each block is passed over or looked at without bounds checks; other walks take walk().
+template <class Distance>
+Hit walkTable(std::span<const std::uint8_t> code, int width, int height, int x, int y,
+              std::int32_t sx, std::int32_t sy, int last, std::span<const BlockStep> blocks,
+              Distance distance) {
+  const BlockStep end = blocks.back();
+  const auto inside = [width, height](int bx, int by) {
+    return bx >= 0 && by >= 0 && bx + 1 < width && by + 1 < height;
+  };
+  if (!inside(x, y) || !inside(x + end.dx, y + end.dy)) {
+    return walk(code, width, height, PointQ8{x * 256, y * 256}, sx, sy, 0, last, distance);
+  }
+  const auto w = static_cast<std::size_t>(width);
+  const auto origin = static_cast<std::ptrdiff_t>(flat(x, y, width));
+  const std::uint8_t* base = code.data();
+  for (const BlockStep b : blocks) {
+    const std::ptrdiff_t block = origin + b.dy * static_cast<std::ptrdiff_t>(width) + b.dx;
+    const std::uint8_t* p = base + block;
+    std::uint16_t top = 0;
+    std::uint16_t bottom = 0;
+    std::memcpy(&top, p, sizeof top);
+    std::memcpy(&bottom, p + w, sizeof bottom);
+    if ((top | bottom) == 0) {
+      continue;
+    }
+    const Hit hit =
+        nearestInInnerBlock(p, w, x + b.dx, y + b.dy, static_cast<std::int32_t>(block), distance);
+    if (hit.at != kNone) {
+      return hit;
+    }
+  }
+  return {kNone, 0};
+}
+
 }  // namespace smx::algo::decode

@@ -51,9 +51,11 @@ class UnitTable {
  public:
   static constexpr int kEntries = 1024;
   void fill();
-  [[nodiscard]] std::int32_t cosOf(std::uint16_t angle) const {
-    return cos_[static_cast<std::size_t>(((angle + 32U) >> 6U) & (kEntries - 1U))];
+  // The entry nearest an angle: cosOf(angle) is entry e's cosine, sinOf(angle) entry e − 256's.
+  [[nodiscard]] static std::size_t entryOf(std::uint16_t angle) {
+    return static_cast<std::size_t>(((angle + 32U) >> 6U) & (kEntries - 1U));
   }
+  [[nodiscard]] std::int32_t cosOf(std::uint16_t angle) const { return cos_[entryOf(angle)]; }
   [[nodiscard]] std::int32_t sinOf(std::uint16_t angle) const {
     return cosOf(static_cast<std::uint16_t>(angle - 16384U));
   }
