@@ -110,6 +110,21 @@ Hit nearestInInnerBlock(const std::uint8_t* p, std::size_t width, int x0, int y0
   return {best, bestDistance};
 }
 
+// nearestInInnerBlock, passing over an empty block with two 2-byte loads: most blocks of a walk
+// hold no boundary.
+template <class Distance>
+Hit lookInInnerBlock(const std::uint8_t* p, std::size_t width, int x0, int y0, std::int32_t i,
+                     Distance& distance) {
+  std::uint16_t top = 0;
+  std::uint16_t bottom = 0;
+  std::memcpy(&top, p, sizeof top);
+  std::memcpy(&bottom, p + width, sizeof bottom);
+  if ((top | bottom) == 0) {
+    return {kNone, 0};
+  }
+  return nearestInInnerBlock(p, width, x0, y0, i, distance);
+}
+
 // The plain walk, block by block (the reference).
 template <class Distance>
 Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start, std::int32_t sx,
@@ -136,9 +151,8 @@ Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 star
 }
 
 // The same walk (the same blocks in the same order, the same hit), faster: when its first and
-// last blocks lie inside the image, so do all between (the steps are monotone), and each step
-// passes over an empty block with two 2-byte loads, no bounds checks; most blocks of a walk
-// hold no boundary. Other walks take the plain one.
+// last blocks lie inside the image, so do all between (the steps are monotone), and each block
+// is looked at without bounds checks. Other walks take the plain one.
 template <class Distance>
 Hit walkSkippingEmpty(std::span<const std::uint8_t> code, int width, int height, PointQ8 start,
                       std::int32_t sx, std::int32_t sy, int first, int last, Distance distance) {
@@ -159,16 +173,8 @@ Hit walkSkippingEmpty(std::span<const std::uint8_t> code, int width, int height,
       continue;
     }
     lastBlock = block;
-    const std::uint8_t* p = base + block;
-    std::uint16_t top = 0;
-    std::uint16_t bottom = 0;
-    std::memcpy(&top, p, sizeof top);
-    std::memcpy(&bottom, p + w, sizeof bottom);
-    if ((top | bottom) == 0) {
-      continue;
-    }
-    const Hit hit =
-        nearestInInnerBlock(p, w, px >> 8, py >> 8, static_cast<std::int32_t>(block), distance);
+    const Hit hit = lookInInnerBlock(base + block, w, px >> 8, py >> 8,
+                                     static_cast<std::int32_t>(block), distance);
     if (hit.at != kNone) {
       return hit;
     }
@@ -220,16 +226,8 @@ Hit walkTable(std::span<const std::uint8_t> code, int width, int height, int x, 
   const std::uint8_t* base = code.data();
   for (const BlockStep b : blocks) {
     const std::ptrdiff_t block = origin + b.dy * static_cast<std::ptrdiff_t>(width) + b.dx;
-    const std::uint8_t* p = base + block;
-    std::uint16_t top = 0;
-    std::uint16_t bottom = 0;
-    std::memcpy(&top, p, sizeof top);
-    std::memcpy(&bottom, p + w, sizeof bottom);
-    if ((top | bottom) == 0) {
-      continue;
-    }
-    const Hit hit =
-        nearestInInnerBlock(p, w, x + b.dx, y + b.dy, static_cast<std::int32_t>(block), distance);
+    const Hit hit = lookInInnerBlock(base + block, w, x + b.dx, y + b.dy,
+                                     static_cast<std::int32_t>(block), distance);
     if (hit.at != kNone) {
       return hit;
     }
