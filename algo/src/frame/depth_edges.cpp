@@ -59,17 +59,20 @@ Result<void> filter(ConstDepthPlane in, DepthPlane out, int maxJumpPermille) {
   for (int y = 0; y < h; ++y) {
     const std::uint16_t* row = in.rowPtr(y);
     std::uint16_t* o = out.rowPtr(y);
-    const bool innerRow = !kReference && maxJumpPermille > 0 && y > 0 && y + 1 < h && w > 2;
-    if (innerRow) {
-      filterInnerRow(in.rowPtr(y - 1), row, in.rowPtr(y + 1), o, w, maxJumpPermille);
-    }
-    for (int x = 0; x < w; x += innerRow && x == 0 ? w - 1 : 1) {
+    const auto pixel = [&](int x) {
       const std::int32_t z = row[x];
-      o[x] = static_cast<std::uint16_t>(z);
-      if (z == kNoDepth || maxJumpPermille == 0) {
-        continue;
-      }
-      o[x] = edgeAt(in, x, y, z, maxJumpPermille * z) ? kNoDepth : static_cast<std::uint16_t>(z);
+      const bool edge =
+          z != kNoDepth && maxJumpPermille > 0 && edgeAt(in, x, y, z, maxJumpPermille * z);
+      o[x] = edge ? kNoDepth : static_cast<std::uint16_t>(z);
+    };
+    if (!kReference && maxJumpPermille > 0 && y > 0 && y + 1 < h && w > 2) {
+      filterInnerRow(in.rowPtr(y - 1), row, in.rowPtr(y + 1), o, w, maxJumpPermille);
+      pixel(0);
+      pixel(w - 1);
+      continue;
+    }
+    for (int x = 0; x < w; ++x) {
+      pixel(x);
     }
   }
   return {};

@@ -1,6 +1,8 @@
 // The median-variant merge (range_merge.hpp; paper §4.2, "data merging stage": the ranges of
 // the separated patterns merged per image). merge<true> is the plain scalar definition,
-// merge<false> the schedule: the same sets, the median found by selection instead of sorting.
+// merge<false> the schedule: the same sets and median, reached with fewer steps (pixels without
+// depth passed over, agreeing full windows taken whole, sets gathered in place, the median by
+// a network or by selection instead of sorting).
 #include "smx/algo/range_merge.hpp"
 
 #include <algorithm>

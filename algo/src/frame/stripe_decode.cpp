@@ -1,7 +1,8 @@
 // Multi-layer decoding (stripe_decode.hpp; paper §4.1–4.2: the colour-stripe permutation code
 // matched along the separated boundaries, multi-layer decoding after its [31]). This scalar code
 // is the reference; where a step has a faster schedule, the same template holds both
-// (kReference), the schedule only passing over work whose result is known. Numerics:
+// (kReference): the schedule passes over work whose result is known or reaches the same result
+// by a shorter way (docs/decode.md "Reference and schedules"). Numerics:
 //   Positions  Q8 pixels (int32); a boundary lies at its pixel centre + offset (Q8) along the
 //              encoding direction of that pixel, whose unit vector is Q1.14 (demux::UnitTable);
 //              the shift offset·u is rounded half up to Q8 once per frame (|shift| ≤ 128).
@@ -169,13 +170,11 @@ Result<StripeDecoder> StripeDecoder::create(int width, int height, const DecodeP
   }
   d.units_[0].fill();
   // The fill's walks per direction entry e (angle 64 e: cosOf and sinOf read entries e, e − 256).
-  const int steps = 2 * params.maxGapPx;
-  const std::size_t perWalk = static_cast<std::size_t>(steps) + 1;
   for (int e = 0; e < demux::UnitTable::kEntries; ++e) {
     const Unit u = unitOf(d.units_[0], static_cast<std::uint16_t>(e * 64));
-    const auto row = d.fillBlocks_.subspan(static_cast<std::size_t>(e) * perWalk, perWalk);
-    d.fillBlockCount_[static_cast<std::size_t>(e)] =
-        static_cast<std::uint8_t>(decode::blockSteps(-(u.x >> 7), -(u.y >> 7), steps, row));
+    const auto entry = static_cast<std::size_t>(e);
+    d.fillBlockCount_[entry] = static_cast<std::uint8_t>(
+        decode::blockSteps(-(u.x >> 7), -(u.y >> 7), 2 * params.maxGapPx, d.fillBlocksOf(entry)));
   }
   for (auto& level : d.level_) {
     level = 0;
@@ -194,31 +193,26 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
   stats_ = DecodeStats{};
   prepare(boundaries, directions);
   if (reference_) {
-    link<true>(directions);
+    runSteps<true>(directions, stripe);
   } else {
-    link<false>(directions);
-  }
-  if (reference_) {
-    vote<true>();
-  } else {
-    vote<false>();
-  }
-  if (reference_) {
-    joinCurves<true>();
-  } else {
-    joinCurves<false>();
-  }
-  if (reference_) {
-    smoothPositions<true>(directions);
-  } else {
-    smoothPositions<false>(directions);
-  }
-  if (reference_) {
-    fill<true>(directions, stripe);
-  } else {
-    fill<false>(directions, stripe);
+    runSteps<false>(directions, stripe);
   }
   return {};
+}
+
+template <bool kReference>
+void StripeDecoder::runSteps(ConstDirectionPlane d, StripePlane stripe) {
+  link<kReference>(d);
+  vote<kReference>();
+  joinCurves<kReference>();
+  smoothPositions<kReference>(d);
+  fill<kReference>(d, stripe);
+}
+
+// The slots of direction entry `entry` in fillBlocks_.
+std::span<decode::BlockStep> StripeDecoder::fillBlocksOf(std::size_t entry) const {
+  const std::size_t perWalk = 2 * static_cast<std::size_t>(params_.maxGapPx) + 1;
+  return fillBlocks_.subspan(entry * perWalk, perWalk);
 }
 
 // Each boundary's class and sub-pixel shift in flat planes (the walks below read them many
@@ -676,9 +670,7 @@ void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
         hit = walk(code_, width_, height_, here, sx, sy, 0, steps, behind);
       } else {
         const std::size_t e = demux::UnitTable::entryOf(dirs[x]);
-        const auto blocks =
-            std::span<const decode::BlockStep>(fillBlocks_)
-                .subspan(e * (static_cast<std::size_t>(steps) + 1), fillBlockCount_[e]);
+        const std::span<const decode::BlockStep> blocks = fillBlocksOf(e).first(fillBlockCount_[e]);
         hit = walkTable(code_, width_, height_, x, y, sx, sy, steps, blocks, behind);
       }
       const std::int32_t q = hit.at;

@@ -88,7 +88,7 @@ class StripeDecoder {
   [[nodiscard]] const DecodeStats& stats() const { return stats_; }
 
   // Every step as its plain scalar definition instead of its schedule: the same output bit for
-  // bit (DecodeSchedule.* compares them), for the tests and the benchmarks.
+  // bit (PipelineSchedule.* compares them), for the tests and the benchmarks.
   void useReferenceKernels(bool on) { reference_ = on; }
 
  private:
@@ -96,6 +96,8 @@ class StripeDecoder {
   template <class Carver>
   [[nodiscard]] Result<void> carve(Carver& carver);
 
+  template <bool kReference>
+  void runSteps(ConstDirectionPlane d, StripePlane stripe);
   void prepare(ConstBoundaryPlane b, ConstDirectionPlane d);
   template <bool kReference>
   void link(ConstDirectionPlane d);
@@ -106,7 +108,7 @@ class StripeDecoder {
   template <bool kReference>
   void smoothPositions(ConstDirectionPlane d);
   void integrateDecoded();
-  [[nodiscard]] bool decodedWithin(int x, int y, int r) const;
+  [[nodiscard]] std::span<decode::BlockStep> fillBlocksOf(std::size_t entry) const;
   template <bool kReference>
   void fill(ConstDirectionPlane d, StripePlane stripe);
 
@@ -128,7 +130,8 @@ class StripeDecoder {
   bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
   std::span<demux::UnitTable> units_;  // one table
-  // The fill's walks per unit-table direction: blocks from stepsPerWalk() each, and how many.
+  // The fill's walks per unit-table direction: 2 · maxGapPx + 1 block slots each (fillBlocksOf),
+  // and how many of them the walk uses.
   std::span<decode::BlockStep> fillBlocks_;
   std::span<std::uint8_t> fillBlockCount_;
   std::span<std::uint8_t> code_;       // Boundary::transition (0: none)

@@ -1,8 +1,8 @@
 #pragma once
 
 // The decoder's shared geometry (stripe_decode.hpp): Q8 positions, Q1.14 unit vectors, packed
-// pixel links and the half-pixel walk along an axis. Internal to src/frame; the reference
-// (decode/reference.cpp) and the schedule (decode/schedule.cpp) both use it.
+// pixel links and the half-pixel walk along an axis, with the walks its schedules take. Internal
+// to src/frame (stripe_decode.cpp).
 
 #include <cstddef>
 #include <cstdint>
@@ -51,11 +51,8 @@ constexpr int packedY(std::int32_t p) {
   return p >> 16;
 }
 
-// Half-pixel steps from `start` along (sx, sy) (Q8 per step), steps first…last; at each step the
-// 2×2 pixels around the sample are looked at (a 1-pixel-thick oblique curve can pass between
-// nearest-pixel samples), each 2×2 block once. `distance(x, y, i)` returns where the boundary
-// at that pixel lies along the walk (Q8), or −1 to pass it over; the nearest accepted pixel of
-// the first block that has one wins, packed (y << 16 | x) with its distance, else kNone.
+// A walk's result: the boundary pixel it stopped at, packed (y << 16 | x), or kNone, and where
+// that boundary lies along the walk (Q8).
 struct Hit {
   std::int32_t at;
   std::int32_t distance;
@@ -125,7 +122,11 @@ Hit lookInInnerBlock(const std::uint8_t* p, std::size_t width, int x0, int y0, s
   return nearestInInnerBlock(p, width, x0, y0, i, distance);
 }
 
-// The plain walk, block by block (the reference).
+// The plain walk (the reference): half-pixel steps from `start` along (sx, sy) (Q8 per step),
+// steps first…last; at each step the 2×2 pixels around the sample are looked at (a 1-pixel-thick
+// oblique curve can pass between nearest-pixel samples), each 2×2 block once. `distance(x, y, i)`
+// returns where the boundary at that pixel lies along the walk (Q8), or −1 to pass it over; the
+// nearest accepted pixel of the first block that has one wins, else kNone.
 template <class Distance>
 Hit walk(std::span<const std::uint8_t> code, int width, int height, PointQ8 start, std::int32_t sx,
          std::int32_t sy, int first, int last, Distance distance) {
