@@ -18,6 +18,8 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
   setup.layout = {cam.width, cam.height, static_cast<int>(rig.projectors.size()), options.demux};
   setup.decode = options.decode;
   setup.edgeJumpPermille = options.edgeJumpPermille;
+  // More lanes than projectors would have nothing to do.
+  setup.lanes = std::clamp(options.lanes, 1, setup.layout.projectors);
   setup.depthUnitM = options.depthUnitM;
   auto angles = predictEncodingAngles(rig, camera, setup.layout, options.nominalDepthM);
   if (!angles) {

@@ -26,6 +26,9 @@
 //   <cfg>/pipeline     CameraPipeline::run(): demux, decode, triangulate and merge
 //   (docs/decode.md); <cfg>/p_decode, p_triangulate, p_merge
 //                      those stages alone, on the output of the pipeline's last run.
+//   <cfg>/pipeline_2threads, p2_decode, p2_triangulate, p2_merge
+//                      the same on two threads (the firmware's worker pool): a lane per
+//                      projector for decoding and triangulation, two bands of rows for the merge.
 // Counters: px/s (frame pixels per CPU second); x_sobel = this benchmark's CPU time per frame /
 // one Sobel's CPU time measured around it (the mean of kLocalSobelCalls calls just before and as
 // many just after the benchmark's loop, on the same frame: this shared machine's speed drifts by
@@ -62,6 +65,7 @@
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/algo/demux.hpp"
 #include "smx/algo/encoding_prediction.hpp"
+#include "smx/device/worker_pool.hpp"
 #include "smx/eval/sim_frame.hpp"
 
 namespace {
@@ -181,11 +185,14 @@ class Stages {
     kern::inverseTileColours(tileSums_, layout_, layout_.params.normaliseColour, tileInverse_);
   }
   void histogram() {
-    kernels_.histogram(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_);
+    kernels_.histogram(smoothed_.views, layout_, filterRows_, tileHistograms_, tileMoments_, 0,
+                       layout_.tilesY());
   }
   void directions() {
-    kernels_.directions(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
-                        tileScratch_);
+    kernels_.lobes(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_, 0,
+                   layout_.tilesY());
+    kernels_.finish(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                    tileScratch_);
   }
   void interpolate() {
     kernels_.interpolation(layout_, tileDirections_, columns_, rows_, filterRows_,
@@ -291,6 +298,12 @@ struct Config {
   std::vector<std::byte> pipelineMemory;
   std::unique_ptr<algo::Arena> pipelineArena;
   std::unique_ptr<algo::CameraPipeline> pipeline;
+  // The same on two threads.
+  std::size_t pipeline2Bytes = 0;
+  std::vector<std::byte> pipeline2Memory;
+  std::unique_ptr<algo::Arena> pipeline2Arena;
+  std::unique_ptr<algo::CameraPipeline> pipeline2;
+  smx::device::WorkerPool pool{1};
   cv::Mat sobelSrc;  // the frame, not copied
   cv::Mat sobelDst;
   double sobelSecondsPerCall = 0.0;  // thread CPU time
@@ -405,6 +418,21 @@ std::unique_ptr<Config> makeConfig(const std::string& rigFile, bool scaled, int 
     die(c->name + ": the pipeline cannot be created or run");
   }
   c->pipeline = std::make_unique<algo::CameraPipeline>(std::move(*pipeline));
+  options.lanes = 2;
+  const auto setup2 = algo::prepareCameraPipeline(c->frame.rig, 0, options);
+  const auto pipeline2Bytes =
+      setup2 ? algo::CameraPipeline::workspaceBytes(*setup2) : algo::Result<std::size_t>(0);
+  if (!setup2 || !pipeline2Bytes) {
+    die(c->name + ": the two-thread pipeline cannot be set up");
+  }
+  c->pipeline2Bytes = *pipeline2Bytes;
+  c->pipeline2Memory.resize(*pipeline2Bytes);
+  c->pipeline2Arena = std::make_unique<algo::Arena>(c->pipeline2Memory);
+  auto pipeline2 = algo::CameraPipeline::create(*setup2, *c->pipeline2Arena);
+  if (!pipeline2 || !pipeline2->run(c->image(), c->pool)) {
+    die(c->name + ": the two-thread pipeline cannot be created or run");
+  }
+  c->pipeline2 = std::make_unique<algo::CameraPipeline>(std::move(*pipeline2));
 
   // The frame as an 8-bit, 3-channel Mat (the channel order does not matter to Sobel).
   c->sobelSrc = cv::Mat(h, w, CV_8UC3, c->frame.image.pixels.data(),
@@ -491,6 +519,23 @@ void registerConfig(Config* c) {
   });
   addWith("p_merge", c->pipelineBytes, [p] {
     auto ok = p->merge();
+    benchmark::DoNotOptimize(ok);
+  });
+  algo::CameraPipeline* p2 = c->pipeline2.get();
+  addWith("pipeline_2threads", c->pipeline2Bytes, [c, p2] {
+    auto ok = p2->run(c->image(), c->pool);
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p2_decode", c->pipeline2Bytes, [c, p2] {
+    auto ok = p2->decode(c->pool);
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p2_triangulate", c->pipeline2Bytes, [c, p2] {
+    auto ok = p2->triangulate(c->pool);
+    benchmark::DoNotOptimize(ok);
+  });
+  addWith("p2_merge", c->pipeline2Bytes, [c, p2] {
+    auto ok = p2->merge(c->pool);
     benchmark::DoNotOptimize(ok);
   });
 }

@@ -2,7 +2,11 @@
 // loop replaying pre-rendered 640x480 frames (the renderer excluded), 2 projectors, streaming to
 // a host over loopback that parses every message and keeps nothing. Counters: captures and range
 // frames per second, bytes per frame on the wire, latency from the capture timestamp to the host
-// (one clock: same machine), frames dropped at the device. Arguments: cameras, decode threads.
+// (one clock: same machine), frames dropped at the device. Arguments: cameras, decode threads
+// (beyond one per camera they split each camera's frame), whether the capture of the next frame
+// overlaps the decoding of the last (pipelined), and the cameras' frame rate: at 1000 fps a
+// frame is always ready and decoding alone sets the pace; at 30 fps, as the board's cameras
+// run, a capture that does not overlap decoding waits for the next frame.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -90,10 +94,14 @@ class Host {
 
 void BM_FirmwareLoop(benchmark::State& state) {
   const auto cameras = static_cast<std::size_t>(state.range(0));
-  const config::Board board = test::replayBoard(static_cast<int>(cameras), 5);
+  config::Board board = test::replayBoard(static_cast<int>(cameras), 5);
+  for (auto& camera : board.config.cameras) {
+    camera.format.fps = static_cast<int>(state.range(3));
+  }
   auto boardHal = hal::createBoardHal(board.config, board.rig).value();
   device::DeviceOptions options;
   options.decodeThreads = static_cast<int>(state.range(1));
+  options.pipelined = state.range(2) != 0;
   auto device = device::Device::create(board, boardHal->hal(), options).value();
   std::atomic<bool> stopNetwork = false;
   std::jthread network([&] { device->runNetwork(stopNetwork); });
@@ -108,6 +116,7 @@ void BM_FirmwareLoop(benchmark::State& state) {
       break;
     }
   }
+  device->finishCapture();
   // Let the host catch up with what was queued.
   const auto deadline = std::chrono::steady_clock::now() + 5s;
   while (host.frames() + device->framesDropped() < device->counters().framesQueued &&
@@ -142,10 +151,16 @@ void BM_FirmwareLoop(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FirmwareLoop)
-    ->ArgNames({"cameras", "threads"})
-    ->Args({1, 1})
-    ->Args({2, 1})
-    ->Args({2, 2})
+    ->ArgNames({"cameras", "threads", "pipelined", "fps"})
+    ->Args({1, 1, 0, 1000})
+    ->Args({1, 2, 0, 1000})
+    ->Args({1, 1, 0, 30})
+    ->Args({1, 1, 1, 30})
+    ->Args({1, 2, 0, 30})
+    ->Args({1, 2, 1, 30})
+    ->Args({2, 1, 0, 1000})
+    ->Args({2, 2, 0, 1000})
+    ->Args({2, 2, 1, 30})
     ->Iterations(30)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

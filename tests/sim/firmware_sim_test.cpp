@@ -137,8 +137,9 @@ class FirmwareSim : public testing::Test {
 };
 
 // 100 captures streamed to a host (with or without the confidence planes) allocate nothing.
-void expectHundredStreamedFramesAllocateNothing(bool confidence) {
-  RunningDevice running(1);
+void expectHundredStreamedFramesAllocateNothing(bool confidence,
+                                                const device::DeviceOptions& options = {}) {
+  RunningDevice running(1, options);
   RawHost host(running.address());
   host.helloAndStart(confidence);
   host.startDraining();
@@ -149,6 +150,7 @@ void expectHundredStreamedFramesAllocateNothing(bool confidence) {
   for (int i = 0; i < 3; ++i) {
     ASSERT_TRUE(running.device().captureOnce().has_value());
   }
+  running.device().finishCapture();  // pipelined, the last one may still be decoding
   const auto& counters = running.device().counters();
   const std::uint64_t decodedBefore = counters.framesDecoded;
   const std::uint64_t queuedBefore = counters.framesQueued;
@@ -158,6 +160,7 @@ void expectHundredStreamedFramesAllocateNothing(bool confidence) {
   for (int i = 0; i < 100; ++i) {
     failed += running.device().captureOnce().has_value() ? 0 : 1;
   }
+  running.device().finishCapture();
   const std::uint64_t heapCalls = allocations.allocations();
 
   EXPECT_EQ(heapCalls, 0U) << "the capture and network loops allocated during 100 frames";
@@ -176,10 +179,22 @@ TEST_F(FirmwareSim, HundredFramesWithConfidenceWhileStreamingAllocateNothing) {
   expectHundredStreamedFramesAllocateNothing(true);
 }
 
+// Two threads on one camera's frame (its projectors on lanes), capture overlapping decoding.
+device::DeviceOptions threadsAndPipelined(int threads) {
+  device::DeviceOptions options;
+  options.decodeThreads = threads;
+  options.pipelined = true;
+  return options;
+}
+
+TEST_F(FirmwareSim, HundredPipelinedFramesOnTwoThreadsAllocateNothing) {
+  expectHundredStreamedFramesAllocateNothing(false, threadsAndPipelined(2));
+}
+
 // Streams 8 frames of two cameras (with the confidence planes when asked), checks that every
 // frame the device sent arrived, and compares each with `stripemux decode` of the same image.
-void expectStreamEqualsOfflineDecode(bool confidence) {
-  RunningDevice running(2);
+void expectStreamEqualsOfflineDecode(bool confidence, const device::DeviceOptions& options = {}) {
+  RunningDevice running(2, options);
   running.startCapture();
   auto client = host::DeviceClient::connect(running.address(), 3000ms);
   ASSERT_TRUE(client.has_value()) << client.error();
@@ -253,6 +268,11 @@ TEST_F(FirmwareSim, StreamedDepthEqualsOfflineDecodeAndEveryFrameSentArrives) {
 
 TEST_F(FirmwareSim, StreamedConfidenceEqualsOfflineDecodeAndEveryFrameSentArrives) {
   expectStreamEqualsOfflineDecode(true);
+}
+
+// Four threads: the two cameras at once, each frame split over two; capture overlaps decoding.
+TEST_F(FirmwareSim, PipelinedOnFourThreadsTheStreamStillEqualsOfflineDecode) {
+  expectStreamEqualsOfflineDecode(true, threadsAndPipelined(4));
 }
 
 // `stripemux stream --confidence` writes a confidence PNG beside each depth PNG, 0 exactly where

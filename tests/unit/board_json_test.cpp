@@ -52,6 +52,12 @@ TEST(BoardJson, TheShippedBoardsLoad) {
   EXPECT_EQ(rpi->config.cameras[0].format.pixelFormat, hal::PixelFormat::kYuyv);
   EXPECT_EQ(rpi->config.trigger.lines[1].offset, 27U);
   EXPECT_EQ(rpi->config.network.bindAddress, "0.0.0.0");
+  // The Pi's four cores decode, and capture overlaps decoding.
+  EXPECT_EQ(rpi->config.threads, 4);
+  EXPECT_TRUE(rpi->config.pipelined);
+  // Unsaid: one thread per camera, capture then decode.
+  EXPECT_EQ(sim->config.threads, 0);
+  EXPECT_FALSE(sim->config.pipelined);
 
   // The hand-held board: 15 fps, one camera, two projectors, the hand-held head scene.
   const auto handheld = loadBoard(kBoards / "sim-handheld");
@@ -98,6 +104,10 @@ TEST(BoardJson, ErrorsNameTheField) {
   expectError(simBoardWith(R"("depth_unit_m")", R"("depth_units_m")"), "",
               "did you mean \"depth_unit_m\"");
   expectError(simBoardWith("stripemux-board/1", "stripemux-rig/1"), "format", "this is a rig.json");
+  expectError(simBoardWith(R"("depth_unit_m")", R"("threads": 0, "depth_unit_m")"), "threads",
+              "from 1 to 64");
+  expectError(simBoardWith(R"("depth_unit_m")", R"("pipelined": "yes", "depth_unit_m")"),
+              "pipelined", "true or false");
 }
 
 // The board's name goes on the wire to every host: an id, not free text.

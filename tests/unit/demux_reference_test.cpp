@@ -308,14 +308,21 @@ void checkHistogram(const Frame& frame) {
     total += w;
   }
   EXPECT_GT(total, 0U);
+  // Whole, and in three bands of tile rows (as lanes run it): each band writes its tiles only.
+  const int tilesY = in.frame.layout.tilesY();
   for (const Schedule& s : schedules()) {
-    std::vector<std::uint32_t> weights(in.weights.size(), 1);
-    std::vector<std::int32_t> moments(in.moments.size(), 1);
-    auto rows = rowMemory<std::int32_t>(demux::kHistogramRows, in.w);
-    s.kernels->histogram(in.smoothed.views, in.frame.layout,
-                         demux::RowBlock<std::int32_t>(rows, in.w), weights, moments);
-    EXPECT_EQ(firstDifference(in.weights, weights), "") << s.name << ": weights";
-    EXPECT_EQ(firstDifference(in.moments, moments), "") << s.name << ": moments";
+    for (const int bands : {1, 3}) {
+      std::vector<std::uint32_t> weights(in.weights.size(), 1);
+      std::vector<std::int32_t> moments(in.moments.size(), 1);
+      auto rows = rowMemory<std::int32_t>(demux::kHistogramRows, in.w);
+      for (int b = 0; b < bands; ++b) {
+        s.kernels->histogram(in.smoothed.views, in.frame.layout,
+                             demux::RowBlock<std::int32_t>(rows, in.w), weights, moments,
+                             b * tilesY / bands, (b + 1) * tilesY / bands);
+      }
+      EXPECT_EQ(firstDifference(in.weights, weights), "") << s.name << ", " << bands << " bands";
+      EXPECT_EQ(firstDifference(in.moments, moments), "") << s.name << ", " << bands << " bands";
+    }
   }
 }
 
@@ -329,14 +336,23 @@ void checkDirections(const Frame& frame) {
     found += d.present;
   }
   EXPECT_GT(found, in.tiles.size() / 3);
+  // The matching whole, and in three bands of tile rows (as lanes run it).
+  const int tilesY = in.frame.layout.tilesY();
   for (const Schedule& s : schedules()) {
-    std::vector<TileDirection> got(in.tiles.size(), TileDirection{1, 7});
-    std::vector<std::uint16_t> scratch(in.tileScratch.size());
-    s.kernels->directions(in.frame.layout, in.weights, in.moments, in.frame.predicted, got,
-                          scratch);
-    for (std::size_t t = 0; t < got.size(); ++t) {
-      EXPECT_EQ(got[t].angle, in.tiles[t].angle) << s.name << ", tile " << t;
-      EXPECT_EQ(got[t].present, in.tiles[t].present) << s.name << ", tile " << t;
+    for (const int bands : {1, 3}) {
+      std::vector<TileDirection> got(in.tiles.size(), TileDirection{1, 7});
+      std::vector<std::uint16_t> scratch(in.tileScratch.size());
+      for (int b = 0; b < bands; ++b) {
+        s.kernels->lobes(in.frame.layout, in.weights, in.moments, in.frame.predicted, got,
+                         b * tilesY / bands, (b + 1) * tilesY / bands);
+      }
+      s.kernels->finish(in.frame.layout, in.weights, in.moments, in.frame.predicted, got, scratch);
+      for (std::size_t t = 0; t < got.size(); ++t) {
+        EXPECT_EQ(got[t].angle, in.tiles[t].angle)
+            << s.name << ", " << bands << " bands, tile " << t;
+        EXPECT_EQ(got[t].present, in.tiles[t].present)
+            << s.name << ", " << bands << " bands, tile " << t;
+      }
     }
   }
 }

@@ -11,8 +11,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "smx/algo/arena.hpp"
@@ -135,6 +137,19 @@ std::string firstDifference(ImageView<const T> a, ImageView<const T> b) {
   return "";
 }
 
+// Rows whose bytes differ, for planes of structs.
+template <class T>
+int rowsDiffering(ImageView<const T> a, ImageView<const T> b) {
+  int rows = 0;
+  for (int y = 0; y < a.height(); ++y) {
+    rows +=
+        std::memcmp(a.rowPtr(y), b.rowPtr(y), sizeof(T) * static_cast<std::size_t>(a.width())) != 0
+            ? 1
+            : 0;
+  }
+  return rows;
+}
+
 TEST(PipelineSchedule, EveryStageAfterDemuxGivesTheReferenceBitForBit) {
   for (const Frame& f : frames()) {
     SCOPED_TRACE(f.name);
@@ -169,6 +184,78 @@ TEST(PipelineSchedule, EveryStageAfterDemuxGivesTheReferenceBitForBit) {
     // The frame must exercise the stages: a good share of it decodes.
     EXPECT_GT(depthPixels, f.width * f.height / 10);
   }
+}
+
+// Runs each job on a thread of its own, all at once, started in reverse order: whatever two
+// lanes or bands share shows as a difference from the serial run.
+class ThreadPerJob final : public JobRunner {
+ public:
+  explicit ThreadPerJob(int width) : width_(width) {}
+  void runJobs(int count, void* context, Call call) override {
+    std::vector<std::thread> threads;
+    for (int i = count - 1; i >= 0; --i) {
+      threads.emplace_back([=] { call(context, i); });
+    }
+    for (std::thread& t : threads) {
+      t.join();
+    }
+  }
+  [[nodiscard]] int width() const override { return width_; }
+
+ private:
+  int width_;
+};
+
+TEST(PipelineSchedule, LanesAndBandsGiveTheSerialPlanesBitForBit) {
+  for (const Frame& f : frames()) {
+    SCOPED_TRACE(f.name);
+    const auto serialSetup = prepareCameraPipeline(f.rig, 0);
+    ASSERT_TRUE(serialSetup.has_value()) << serialSetup.error();
+    Pipeline serial = Pipeline::make(*serialSetup);
+    const ConstRgbView image = *ConstRgbView::packed(f.image, f.width, f.height);
+    ASSERT_TRUE(serial.pipeline.run(image));
+    for (const int lanes : {2, 3}) {
+      PipelineOptions options;
+      options.lanes = lanes;
+      const auto setup = prepareCameraPipeline(f.rig, 0, options);
+      ASSERT_TRUE(setup.has_value()) << setup.error();
+      Pipeline parallel = Pipeline::make(*setup);
+      // More lanes than projectors would idle: the setup asks for no more.
+      ASSERT_EQ(parallel.pipeline.lanes(),
+                std::min(lanes, static_cast<int>(f.rig.projectors.size())));
+      // Two frames, so that a lane's state left from the first would show in the second.
+      for (const int bands : {lanes, 7}) {
+        SCOPED_TRACE(std::to_string(lanes) + " lanes, " + std::to_string(bands) + " bands");
+        ThreadPerJob jobs(bands);
+        ASSERT_TRUE(parallel.pipeline.run(image, jobs));
+        const CameraPipeline& a = parallel.pipeline;
+        const CameraPipeline& b = serial.pipeline;
+        for (int p = 0; p < a.projectors(); ++p) {
+          SCOPED_TRACE("projector " + std::to_string(p));
+          EXPECT_EQ(rowsDiffering(a.demux().boundaries(p), b.demux().boundaries(p)), 0)
+              << "boundaries";
+          EXPECT_EQ(firstDifference(a.stripe(p), b.stripe(p)), "") << "stripe";
+          EXPECT_EQ(firstDifference(a.levels(p), b.levels(p)), "") << "levels";
+          EXPECT_EQ(firstDifference(a.depth(p), b.depth(p)), "") << "depth";
+          EXPECT_EQ(firstDifference(a.confidence(p), b.confidence(p)), "") << "confidence";
+          EXPECT_EQ(a.decodeStats(p).densePixels, b.decodeStats(p).densePixels);
+          EXPECT_EQ(a.decodeStats(p).curves, b.decodeStats(p).curves);
+        }
+        EXPECT_EQ(firstDifference(a.merged(), b.merged()), "") << "merged depth";
+        EXPECT_EQ(firstDifference(a.confidence(), b.confidence()), "") << "merged confidence";
+      }
+    }
+  }
+}
+
+TEST(PipelineSchedule, LanesBeyondTheProjectorsAreRefused) {
+  const Frame& f = frames().front();
+  auto setup = prepareCameraPipeline(f.rig, 0);
+  ASSERT_TRUE(setup.has_value());
+  setup->lanes = setup->layout.projectors + 1;
+  EXPECT_FALSE(CameraPipeline::workspaceBytes(*setup).has_value());
+  setup->lanes = 0;
+  EXPECT_FALSE(CameraPipeline::workspaceBytes(*setup).has_value());
 }
 
 // Range images that take the merge's every branch: one smooth surface measured by up to eight

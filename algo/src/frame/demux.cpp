@@ -20,16 +20,18 @@ void UnitTable::fill() {
 }
 
 const Kernels& baselineKernels() {
-  static constexpr Kernels kBaseline{smoothChannels,        histogramTiles, estimateDirections,
-                                     interpolateDirections, separate,       detectBoundaries};
+  static constexpr Kernels kBaseline{smoothChannels,   histogramTiles,        matchTileLobes,
+                                     finishDirections, interpolateDirections, separate,
+                                     detectBoundaries};
   return kBaseline;
 }
 
 const Kernels& fastestKernels() {
 #if SMX_DEMUX_AVX2
-  static constexpr Kernels kAvx2{avx2::smoothChannels,     avx2::histogramTiles,
-                                 avx2::estimateDirections, avx2::interpolateDirections,
-                                 avx2::separate,           avx2::detectBoundaries};
+  static constexpr Kernels kAvx2{avx2::smoothChannels,        avx2::histogramTiles,
+                                 avx2::matchTileLobes,        avx2::finishDirections,
+                                 avx2::interpolateDirections, avx2::separate,
+                                 avx2::detectBoundaries};
   if (__builtin_cpu_supports("avx2")) {
     return kAvx2;
   }
@@ -41,13 +43,16 @@ const Kernels& fastestKernels() {
 
 namespace {
 
-Result<void> validate(const DemuxLayout& l) {
+Result<void> validate(const DemuxLayout& l, int lanes) {
   const DemuxParams& p = l.params;
   if (l.width < 8 || l.height < 8 || l.width > 8192 || l.height > 8192) {
     return fail(Errc::kInvalidArgument, "demux: image size must be 8 to 8192 pixels per side");
   }
   if (l.projectors < 1 || l.projectors > kMaxProjectors) {
     return fail(Errc::kInvalidArgument, "demux: 1 to 3 projectors");
+  }
+  if (lanes < 1 || lanes > l.projectors) {
+    return fail(Errc::kInvalidArgument, "demux: 1 lane to one per projector");
   }
   if (p.tilePx < 4 || p.tilePx > 64 || p.windowTiles < 1 || p.windowTiles > 9 ||
       p.windowTiles % 2 == 0 || p.histogramStride < 1 || p.histogramStride > 8 ||
@@ -105,8 +110,20 @@ Result<void> Demultiplexer::carve(Carver& carver) {
       step(carveImage(carver, plane, l.width, l.height));
     }
   }
-  step(carveImage(carver, strength_, l.width, l.height));
-  step(carveImage(carver, derivativeStrength_, l.width, l.height));
+  for (int lane = 0; lane < lanes_; ++lane) {
+    LaneScratch& scratch = laneScratch_[static_cast<std::size_t>(lane)];
+    if (lane == 0) {
+      scratch.histogramRows = filterRows_;
+      scratch.workRows = workRows_;
+    } else {
+      step(carveSpan(carver, scratch.histogramRows,
+                     demux::RowBlock<std::int32_t>::valuesFor(demux::kHistogramRows, l.width)));
+      step(carveSpan(carver, scratch.workRows,
+                     demux::RowBlock<std::int16_t>::valuesFor(demux::kSharedWorkRows, l.width)));
+    }
+    step(carveImage(carver, scratch.strength, l.width, l.height));
+    step(carveImage(carver, scratch.derivativeStrength, l.width, l.height));
+  }
   for (std::size_t p = 0; p < projectors; ++p) {
     step(carveImage(carver, order_[p], l.width, l.height));
     step(carveImage(carver, boundaries_[p], l.width, l.height));
@@ -115,12 +132,13 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   return ok;
 }
 
-Result<std::size_t> Demultiplexer::workspaceBytes(const DemuxLayout& layout) {
-  if (auto ok = validate(layout); !ok) {
+Result<std::size_t> Demultiplexer::workspaceBytes(const DemuxLayout& layout, int lanes) {
+  if (auto ok = validate(layout, lanes); !ok) {
     return std::unexpected(ok.error());
   }
   Demultiplexer d;
   d.layout_ = layout;
+  d.lanes_ = lanes;
   ArenaSizer sizer;
   if (auto ok = d.carve(sizer); !ok) {
     return std::unexpected(ok.error());
@@ -130,8 +148,8 @@ Result<std::size_t> Demultiplexer::workspaceBytes(const DemuxLayout& layout) {
 
 Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
                                             std::span<const std::uint16_t> predictedAngles,
-                                            Arena& arena, DemuxSchedule schedule) {
-  if (auto ok = validate(layout); !ok) {
+                                            Arena& arena, DemuxSchedule schedule, int lanes) {
+  if (auto ok = validate(layout, lanes); !ok) {
     return std::unexpected(ok.error());
   }
   if (predictedAngles.size() != layout.tileCount() * static_cast<std::size_t>(layout.projectors)) {
@@ -139,6 +157,7 @@ Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
   }
   Demultiplexer d;
   d.layout_ = layout;
+  d.lanes_ = lanes;
   const Arena::Marker start = arena.mark();
   if (auto ok = d.carve(arena); !ok) {
     arena.rewind(start);
@@ -156,6 +175,11 @@ Result<Demultiplexer> Demultiplexer::create(const DemuxLayout& layout,
 }
 
 Result<void> Demultiplexer::run(ConstRgbView image) {
+  SerialJobs serial;
+  return run(image, serial);
+}
+
+Result<void> Demultiplexer::run(ConstRgbView image, JobRunner& jobs) {
   if (image.width() != layout_.width || image.height() != layout_.height) {
     return fail(Errc::kSizeMismatch, "demux: image size differs from the layout");
   }
@@ -166,11 +190,23 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
   if (!fixedDirections_) {
     // separate()'s filter rows are free until it runs.
     static_assert(demux::kHistogramRows <= demux::kFilterRows);
-    kernels_->histogram(smoothed_, layout_,
-                        demux::RowBlock<std::int32_t>(filterRows_, layout_.width), tileHistograms_,
-                        tileMoments_);
-    kernels_->directions(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
-                         tileScratch_);
+    const int tilesY = layout_.tilesY();
+    auto band = [&](int b) {
+      kernels_->histogram(
+          smoothed_, layout_,
+          demux::RowBlock<std::int32_t>(laneScratch_[static_cast<std::size_t>(b)].histogramRows,
+                                        layout_.width),
+          tileHistograms_, tileMoments_, b * tilesY / lanes_, (b + 1) * tilesY / lanes_);
+    };
+    jobs.forEach(lanes_, band);
+    // Each tile's window reaches into the neighbouring bands: the matching waits for all of them.
+    auto lobes = [&](int b) {
+      kernels_->lobes(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                      b * tilesY / lanes_, (b + 1) * tilesY / lanes_);
+    };
+    jobs.forEach(lanes_, lobes);
+    kernels_->finish(layout_, tileHistograms_, tileMoments_, predicted_, tileDirections_,
+                     tileScratch_);
   }
   const auto projectors = static_cast<std::size_t>(layout_.projectors);
   static_assert(demux::kInterpolationRows <= demux::kFilterRows);
@@ -186,12 +222,17 @@ Result<void> Demultiplexer::run(ConstRgbView image) {
                        std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
   // separate() is done with its working rows: they hold detectBoundaries()' ring.
   const demux::TileColours colours{tileInverseColour_, layout_.tilesX(), columns_, rows_};
-  for (std::size_t q = 0; q < projectors; ++q) {
-    kernels_->boundaries(separated_[q], order_[q], directions_[q], units_[0], colours,
-                         demux::minStrengthQ11(p),
-                         demux::RowBlock<std::int16_t>(workRows_, layout_.width),
-                         {strength_, derivativeStrength_}, boundaries_[q]);
-  }
+  auto lane = [&](int l) {
+    const LaneScratch& scratch = laneScratch_[static_cast<std::size_t>(l)];
+    for (auto q = static_cast<std::size_t>(l); q < projectors;
+         q += static_cast<std::size_t>(lanes_)) {
+      kernels_->boundaries(separated_[q], order_[q], directions_[q], units_[0], colours,
+                           demux::minStrengthQ11(p),
+                           demux::RowBlock<std::int16_t>(scratch.workRows, layout_.width),
+                           {scratch.strength, scratch.derivativeStrength}, boundaries_[q]);
+    }
+  };
+  jobs.forEach(lanes_, lane);
   return {};
 }
 

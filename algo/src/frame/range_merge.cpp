@@ -161,7 +161,8 @@ std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std
 template <bool kReference>
 Result<void> merge(std::span<const ConstDepthPlane> ranges,
                    std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
-                   ImageView<std::uint8_t>* outConfidence, const DepthTolerance& tolerance) {
+                   ImageView<std::uint8_t>* outConfidence, const DepthTolerance& tolerance,
+                   RowBand rows) {
   if (ranges.empty() || ranges.size() > static_cast<std::size_t>(kMaxRanges)) {
     return fail(Errc::kInvalidArgument, "merge: 1 to 8 range images");
   }
@@ -195,7 +196,8 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
   std::array<std::uint16_t, kMaxValues> chosen{};
   std::array<std::uint16_t, kWindow> next{};
   std::array<std::uint16_t, kMaxRanges> centre{};
-  for (int y = 0; y < h; ++y) {
+  const int yEnd = rows.end < h ? rows.end : h;
+  for (int y = rows.begin > 0 ? rows.begin : 0; y < yEnd; ++y) {
     std::uint16_t* o = out.rowPtr(y);
     std::uint8_t* oc = outConfidence != nullptr ? outConfidence->rowPtr(y) : nullptr;
     const int y0 = y > 0 ? y - 1 : 0;
@@ -302,20 +304,21 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
 
 Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out,
                          const DepthTolerance& tolerance) {
-  return merge<false>(ranges, {}, out, nullptr, tolerance);
+  return merge<false>(ranges, {}, out, nullptr, tolerance, {});
 }
 
 Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges,
                          std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
-                         ImageView<std::uint8_t> outConfidence, const DepthTolerance& tolerance) {
-  return merge<false>(ranges, confidences, out, &outConfidence, tolerance);
+                         ImageView<std::uint8_t> outConfidence, const DepthTolerance& tolerance,
+                         RowBand rows) {
+  return merge<false>(ranges, confidences, out, &outConfidence, tolerance, rows);
 }
 
 Result<void> mergeRangesReference(std::span<const ConstDepthPlane> ranges,
                                   std::span<const ImageView<const std::uint8_t>> confidences,
                                   DepthPlane out, ImageView<std::uint8_t> outConfidence,
                                   const DepthTolerance& tolerance) {
-  return merge<true>(ranges, confidences, out, &outConfidence, tolerance);
+  return merge<true>(ranges, confidences, out, &outConfidence, tolerance, {});
 }
 
 }  // namespace smx::algo

@@ -12,44 +12,89 @@ namespace {
 constexpr std::int64_t kRecoveryWaitNs = 100'000'000;  // between attempts to reopen a camera
 }  // namespace
 
-hal::HalResult<void> Device::captureOnce() {
-  if (auto on = hal_.trigger.set(rangeProjectorsMask_); !on) {
-    ++counters_.captureErrors;
-    return on;
+Device::Acquired Device::acquireFrames(std::uint32_t mask, std::vector<hal::CameraFrame>& frames) {
+  Acquired got;
+  if (auto on = hal_.trigger.set(mask); !on) {
+    got.status = on;
+    got.failed = "trigger lines";
+    return got;
   }
+  got.triggered = true;
   if (leadNs_ > 0) {
     hal_.clock.sleepUntilNs(hal_.clock.nowNs() + leadNs_);
   }
-  std::size_t acquired = 0;
-  hal::HalResult<void> status;
   for (hal::Camera* camera : hal_.cameras) {
     auto frame = camera->acquire(options_.acquireTimeoutNs);
     if (!frame) {
-      status = std::unexpected(frame.error());
+      got.status = std::unexpected(frame.error());
+      got.failed = camera->id();
       break;
     }
-    frames_[acquired++] = *frame;
+    frames[got.count++] = *frame;
   }
   (void)hal_.trigger.set(0);  // a line that cannot be cleared fails the next set() too
-  counters_.framesCaptured += acquired;
+  counters_.framesCaptured += got.count;
+  return got;
+}
 
-  if (status) {
-    auto job = [this](int camera) { decodeCamera(camera); };
-    workers_->run(static_cast<int>(acquired), job);
-  } else {
+void Device::releaseFrames(const std::vector<hal::CameraFrame>& frames, std::size_t count) const {
+  for (std::size_t i = 0; i < count; ++i) {
+    (void)hal_.cameras[i]->release(frames[i]);
+  }
+}
+
+// A failed capture returns with nothing decoding, so that recover() may take back every buffer.
+hal::HalResult<void> Device::captureOnce() {
+  // Pipelined, the capture goes to next_ while frames_ may still be decoding: just in time, the
+  // frame that arrives as the decoding ends, not one that would wait a whole decode for it.
+  if (decoding_ && decodingCount_ > 0) {
+    const std::int64_t ready = decodeStartNs_ + lastDecodeNs_ - framePeriodNs_;
+    if (ready > hal_.clock.nowNs()) {
+      hal_.clock.sleepUntilNs(ready);
+    }
+  }
+  std::vector<hal::CameraFrame>& into = decoding_ ? next_ : frames_;
+  const Acquired got = acquireFrames(rangeProjectorsMask_, into);
+  finishCapture();
+  if (!got.status) {
     ++counters_.captureErrors;
+    releaseFrames(into, got.count);
+    captureNumber_ += got.triggered ? 1 : 0;
+    return got.status;
   }
-  for (std::size_t i = 0; i < acquired; ++i) {
-    (void)hal_.cameras[i]->release(frames_[i]);
+  if (decoding_) {
+    std::swap(frames_, next_);  // the new capture is the one to decode
   }
-  ++captureNumber_;
-  return status;
+  decodingCount_ = got.count;
+  decodingNumber_ = captureNumber_++;
+  decodeStartNs_ = hal_.clock.nowNs();
+  if (decoding_) {
+    decoding_->start(this, [](void* device) { static_cast<Device*>(device)->decodeFrames(); });
+  } else {
+    decodeFrames();
+    finishCapture();
+  }
+  return got.status;
+}
+
+void Device::finishCapture() {
+  if (decoding_) {
+    decoding_->wait();
+  }
+  releaseFrames(frames_, decodingCount_);
+  decodingCount_ = 0;
+}
+
+void Device::decodeFrames() {
+  auto job = [this](int camera) { decodeCamera(camera); };
+  workers_->forEach(static_cast<int>(decodingCount_), job);
+  lastDecodeNs_ = hal_.clock.nowNs() - decodeStartNs_;
 }
 
 void Device::decodeCamera(int camera) {
   const auto i = static_cast<std::size_t>(camera);
   const std::int64_t start = hal_.clock.nowNs();
-  if (!cameras_[i].pipeline->run(frames_[i].image)) {
+  if (!cameras_[i].pipeline->run(frames_[i].image, *cameras_[i].jobs)) {
     ++counters_.captureErrors;
     return;
   }
@@ -65,7 +110,7 @@ void Device::decodeCamera(int camera) {
 void Device::queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs) {
   const protocol::RangeFrameHeader header{.camera = static_cast<std::uint8_t>(camera),
                                           .compression = compression_,
-                                          .frame = captureNumber_,
+                                          .frame = decodingNumber_,
                                           .captureTimestampNs = frame.timestampNs,
                                           .sentTimestampNs = hal_.clock.nowNs(),
                                           .depthUnitNm = depthUnitNm_,
@@ -90,6 +135,7 @@ bool Device::serveRawCapture() {
   if (!rawState_.compare_exchange_strong(requested, RawState::kCapturing)) {
     return false;
   }
+  finishCapture();  // captureRaw() borrows into frames_
   rawSize_ = captureRaw(rawMask_);
   ++counters_.rawCaptures;
   rawState_ = RawState::kReady;  // publishes raw_ to the network loop
@@ -110,26 +156,10 @@ std::size_t Device::rawError(std::string_view what, const hal::HalError& error) 
 }
 
 std::size_t Device::captureRaw(std::uint32_t mask) {
-  if (auto on = hal_.trigger.set(mask); !on) {
-    return rawError("trigger lines", on.error());
-  }
-  if (leadNs_ > 0) {
-    hal_.clock.sleepUntilNs(hal_.clock.nowNs() + leadNs_);
-  }
-  std::size_t acquired = 0;
-  std::size_t size = 0;
-  bool failed = false;
-  for (hal::Camera* camera : hal_.cameras) {
-    auto frame = camera->acquire(options_.acquireTimeoutNs);
-    if (!frame) {
-      size = rawError(camera->id(), frame.error());
-      failed = true;
-      break;
-    }
-    frames_[acquired++] = *frame;
-  }
-  (void)hal_.trigger.set(0);
-  counters_.framesCaptured += acquired;
+  const Acquired got = acquireFrames(mask, frames_);
+  const std::size_t acquired = got.count;
+  bool failed = !got.status;
+  std::size_t size = failed ? rawError(got.failed, got.status.error()) : 0;
   const std::uint64_t number = counters_.rawCaptures;
   for (std::size_t i = 0; !failed && i < acquired; ++i) {
     const algo::ConstRgbView image = frames_[i].image;
@@ -174,6 +204,7 @@ void Device::runCapture(const std::atomic<bool>& stop) {
       hal_.clock.sleepUntilNs(hal_.clock.nowNs() + kRecoveryWaitNs);
     }
   }
+  finishCapture();
 }
 
 }  // namespace smx::device

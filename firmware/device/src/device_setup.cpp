@@ -31,7 +31,10 @@ Device::Device(const config::Board& board, hal::Hal hal, const DeviceOptions& op
                                        board.rig.cameras.front().height, true)),
       parser_(kConfigBytes) {}
 
-Device::~Device() = default;
+// A capture still decoding uses the queue and the counters, which go before the decoding thread.
+Device::~Device() {
+  finishCapture();
+}
 
 std::expected<std::unique_ptr<Device>, std::string> Device::create(const config::Board& board,
                                                                    hal::Hal hal,
@@ -62,9 +65,19 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
   pipelineOptions.depthUnitM = board.config.depthUnitM;
   device->cameras_.resize(rig.cameras.size());
   device->frames_.resize(rig.cameras.size());
-  const int threads =
-      options.decodeThreads > 0 ? options.decodeThreads : static_cast<int>(rig.cameras.size());
-  device->workers_ = std::make_unique<WorkerPool>(threads - 1);
+  device->next_.resize(rig.cameras.size());
+  const auto cameraCount = static_cast<int>(rig.cameras.size());
+  const int threads = options.decodeThreads > 0  ? options.decodeThreads
+                      : board.config.threads > 0 ? board.config.threads
+                                                 : cameraCount;
+  // The cameras decode in parallel; threads beyond one per camera split each camera's frame
+  // (its projectors on lanes, its merge in bands) on a pool of the camera's own.
+  const int perCamera = std::max(1, threads / cameraCount);
+  device->workers_ = std::make_unique<WorkerPool>(std::min(threads, cameraCount) - 1);
+  pipelineOptions.lanes = perCamera;
+  if (options.pipelined || board.config.pipelined) {
+    device->decoding_ = std::make_unique<BackgroundJob>();
+  }
   for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
     const std::string& id = rig.cameras[i].id;
     const auto setup = algo::prepareCameraPipeline(decodeRig, static_cast<int>(i), pipelineOptions);
@@ -76,6 +89,7 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
       return Fail("camera " + id + ": " + bytes.error().message);
     }
     CameraSlot& slot = device->cameras_[i];
+    slot.jobs = std::make_unique<WorkerPool>(perCamera - 1);
     slot.memory.resize(*bytes);
     slot.arena = std::make_unique<algo::Arena>(slot.memory);
     auto pipeline = algo::CameraPipeline::create(*setup, *slot.arena);
@@ -90,6 +104,8 @@ std::expected<std::unique_ptr<Device>, std::string> Device::create(const config:
       return Fail("camera " + id + ": cannot configure " + board.config.cameras[i].device + ": " +
                   format.error().message);
     }
+    const std::int64_t periodNs = 1'000'000'000 / std::max(1, format->fps);
+    device->framePeriodNs_ = i == 0 ? periodNs : std::min(device->framePeriodNs_, periodNs);
     if (const auto set = camera.setControls(board.config.cameras[i].controls); !set) {
       return Fail("camera " + id + ": exposure or gain: " + set.error().message);
     }

@@ -77,6 +77,7 @@ bool Device::serveTurn() {
       !turnState_.compare_exchange_strong(requested, TurnState::kMoving)) {
     return false;
   }
+  finishCapture();  // the frame taken before the move goes out before its answer
   const auto moved = hal_.turntable->move(turnSteps_);
   turnFailed_ = !moved;
   if (!moved) {

@@ -31,7 +31,7 @@ bool WorkerPool::runNext(std::unique_lock<std::mutex>& lock) {
   return true;
 }
 
-void WorkerPool::runRaw(int count, void* context, Call call) {
+void WorkerPool::runJobs(int count, void* context, Call call) {
   std::unique_lock lock(mutex_);
   context_ = context;
   call_ = call;

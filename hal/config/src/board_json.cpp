@@ -22,9 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr std::array<std::string_view, 11> kTopKeys = {
-    "format",   "name",    "hal", "rig",         "depth_unit_m", "cameras",
-    "triggers", "network", "sim", "description", "turntable"};
+constexpr std::array<std::string_view, 13> kTopKeys = {
+    "format",  "name", "hal",         "rig",       "depth_unit_m", "cameras",  "triggers",
+    "network", "sim",  "description", "turntable", "threads",      "pipelined"};
 constexpr std::array<std::string_view, 5> kCameraKeys = {"id", "device", "pixel_format", "fps",
                                                          "buffers"};
 constexpr std::array<std::string_view, 2> kTriggerKeys = {"lead_us", "lines"};
@@ -337,6 +337,8 @@ std::expected<Board, BoardError> parseBoardImpl(std::string_view text, const fs:
                                " m, and every depth beyond the limit would be lost; use at least " +
                                formatNumber(algo::minDepthUnitM(algo::kDefaultNominalDepthM)));
   }
+  r.integer(doc, "", "threads", 1, 64, "decoding threads (the board's cores)", board.threads);
+  r.boolean(doc, "", "pipelined", board.pipelined);
   if (r.ok()) {
     readCameras(r, doc, out.rig, board);
     readTriggers(r, doc, out.rig, board);

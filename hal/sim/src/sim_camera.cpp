@@ -80,14 +80,15 @@ hal::HalResult<hal::CameraFrame> SimCamera::acquire(std::int64_t timeoutNs) {
   if (free == borrowed_.end()) {
     return halFail(HalErrc::kBusy, "every buffer is borrowed; release one first");
   }
-  // Frame k is exposed at start + k / fps; frames whose time has passed are lost.
+  // Frame k is exposed from start + k / fps; frames whose exposure began before the ask are lost
+  // (their light came before the projectors' trigger), so the first one handed out is the next.
   const std::int64_t periodNs = kNsPerS / format_.fps;
   const std::int64_t now = clock_.nowNs();
   const auto due = [&](std::uint64_t k) {
     return streamStartNs_ + static_cast<std::int64_t>(k) * periodNs;
   };
-  const auto latest = static_cast<std::uint64_t>((now - streamStartNs_) / periodNs);
-  std::uint64_t next = std::max(sequence_ + 1, latest);
+  const auto first = static_cast<std::uint64_t>((now - streamStartNs_ + periodNs - 1) / periodNs);
+  std::uint64_t next = std::max(sequence_ + 1, first);
   next += static_cast<std::uint64_t>(pendingDrops_.exchange(0));
   if (due(next) - now > timeoutNs) {
     clock_.sleepUntilNs(now + timeoutNs);

@@ -14,6 +14,7 @@
 #include "smx/algo/depth_window.hpp"
 #include "smx/algo/error.hpp"
 #include "smx/algo/image_view.hpp"
+#include "smx/algo/jobs.hpp"
 #include "smx/algo/range_image.hpp"
 #include "smx/algo/rig.hpp"
 #include "smx/algo/stripe_decode.hpp"
@@ -24,6 +25,12 @@
 // merging of the projectors' range images (consistency vote, then the paper's median-variant
 // filter), with a confidence per merged depth. Per frame integer-only and
 // allocation-free; all memory is carved from one arena at create().
+//
+// Within a frame, projectors' boundaries are detected, decoded and triangulated on up to `lanes`
+// threads at once (a lane is one decoder's memory, one scratch depth plane and the boundary
+// detector's strength planes) and the merge is cut into bands of rows:
+// given a JobRunner, the stages hand it those parts. The planes are the same for any lanes and
+// any runner (PipelineSchedule.LanesAndBands* compares them).
 namespace smx::algo {
 
 // Where the rig predicts the pattern directions when nothing says otherwise (a board, the CLI).
@@ -42,6 +49,7 @@ struct PipelineOptions {
   double minDepthM = 0.0;
   double maxDepthM = 1e9;
   int minConfidence = 1;  // 1…255
+  int lanes = 1;          // projectors decoded at once (1…3), each lane with its own decoder
 };
 
 // Init time (double, allocates): the tables the pipeline needs, computed from the rig.
@@ -49,6 +57,7 @@ struct CameraPipelineSetup {
   DemuxLayout layout;
   DecodeParams decode;
   int edgeJumpPermille = 20;
+  int lanes = 1;
   DepthTrustParams trust;
   double depthUnitM = kDefaultDepthUnitM;
   DepthWindow window;
@@ -64,7 +73,13 @@ class CameraPipeline {
   [[nodiscard]] static Result<CameraPipeline> create(const CameraPipelineSetup& setup,
                                                      Arena& arena);
 
-  // The stages in order (run() calls all four); separate so that callers can time them.
+  // The stages in order (run() calls all four); separate so that callers can time them. Those
+  // given a JobRunner hand it their independent parts; without one they run on the caller.
+  [[nodiscard]] Result<void> demultiplex(ConstRgbView image, JobRunner& jobs);
+  [[nodiscard]] Result<void> decode(JobRunner& jobs);
+  [[nodiscard]] Result<void> triangulate(JobRunner& jobs);
+  [[nodiscard]] Result<void> merge(JobRunner& jobs);
+  [[nodiscard]] Result<void> run(ConstRgbView image, JobRunner& jobs);
   [[nodiscard]] Result<void> demultiplex(ConstRgbView image);
   [[nodiscard]] Result<void> decode();
   [[nodiscard]] Result<void> triangulate();
@@ -76,6 +91,7 @@ class CameraPipeline {
   void useReferenceKernels(bool on);
 
   [[nodiscard]] int projectors() const { return layout_.projectors; }
+  [[nodiscard]] int lanes() const { return lanes_; }
   // create() sets every stage object: a CameraPipeline exists only after it.
   // NOLINTNEXTLINE(bugprone-unchecked-optional-access)
   [[nodiscard]] const Demultiplexer& demux() const { return *demux_; }
@@ -95,21 +111,28 @@ class CameraPipeline {
   CameraPipeline() = default;
   template <class Carver>
   [[nodiscard]] Result<void> carve(Carver& carver);
+  [[nodiscard]] Result<void> decodeProjector(int projector, StripeDecoder& decoder);
+  [[nodiscard]] Result<void> triangulateProjector(int projector, DepthPlane scratch);
+  // Runs perProjector(p, lane) for every projector on the lanes, lane l taking l, l + lanes, …
+  template <class PerProjector>
+  [[nodiscard]] Result<void> onLanes(JobRunner& jobs, const PerProjector& perProjector);
 
   DemuxLayout layout_;
   int edgeJumpPermille_ = 0;
   DepthTrustParams trust_;
   DepthWindow window_;
   bool reference_ = false;
+  int lanes_ = 1;
   std::optional<Demultiplexer> demux_;
-  std::optional<StripeDecoder> decoder_;
+  std::array<std::optional<StripeDecoder>, kMaxProjectors> decoders_;  // one per lane
   std::array<std::optional<Triangulator>, kMaxProjectors> triangulators_;
   std::array<StripePlane, kMaxProjectors> stripes_;
   std::array<ImageView<std::int16_t>, kMaxProjectors> levels_;
   std::array<DecodeStats, kMaxProjectors> stats_;
   std::array<DepthPlane, kMaxProjectors> depths_;
   std::array<ImageView<std::uint8_t>, kMaxProjectors> confidences_;
-  DepthPlane merged_;
+  DepthPlane merged_;                               // also lane 0's scratch before merge()
+  std::array<DepthPlane, kMaxProjectors> scratch_;  // lane l's unfiltered range image (l ≥ 1)
   ImageView<std::uint8_t> mergedConfidence_;
 };
 

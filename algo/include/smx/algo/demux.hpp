@@ -9,6 +9,7 @@
 #include "smx/algo/boundary_map.hpp"
 #include "smx/algo/error.hpp"
 #include "smx/algo/image_view.hpp"
+#include "smx/algo/jobs.hpp"
 
 // Orientation demultiplexing (paper §3, §4.2–4.3; docs/demux.md): from one camera image in which
 // the same colour-stripe pattern of 1–3 projectors is superposed at different orientations,
@@ -85,16 +86,22 @@ struct Kernels;
 
 class Demultiplexer {
  public:
-  // The most arena bytes create() takes for this layout, alignment padding included.
-  [[nodiscard]] static Result<std::size_t> workspaceBytes(const DemuxLayout& layout);
+  // The most arena bytes create() takes for this layout, alignment padding included. `lanes`
+  // (1 to one per projector): how many projectors' boundaries run() may detect at once, each
+  // lane with its own working rows and strength planes.
+  [[nodiscard]] static Result<std::size_t> workspaceBytes(const DemuxLayout& layout, int lanes = 1);
 
   // predictedAngles: tileCount() × projectors values, tile-major (tile t, projector p at
   // t * projectors + p); copied into the arena.
   [[nodiscard]] static Result<Demultiplexer> create(
       const DemuxLayout& layout, std::span<const std::uint16_t> predictedAngles, Arena& arena,
-      DemuxSchedule schedule = DemuxSchedule::kAutomatic);
+      DemuxSchedule schedule = DemuxSchedule::kAutomatic, int lanes = 1);
 
   // Per frame: every projector's boundaries and directions. The image must be width × height.
+  // Given a JobRunner, the tile histograms and the matching of their lobes run in bands of
+  // tile rows and the projectors' boundaries are detected on the lanes at once; the planes are
+  // the same either way.
+  [[nodiscard]] Result<void> run(ConstRgbView image, JobRunner& jobs);
   [[nodiscard]] Result<void> run(ConstRgbView image);
 
   [[nodiscard]] const DemuxLayout& layout() const { return layout_; }
@@ -118,7 +125,17 @@ class Demultiplexer {
   template <class Carver>
   [[nodiscard]] Result<void> carve(Carver& carver);
 
+  // A lane's working memory: for a band of tile rows' histograms, and for detecting one
+  // projector's boundaries besides its planes. Lane 0's rows are filterRows_ and workRows_.
+  struct LaneScratch {
+    std::span<std::int32_t> histogramRows;
+    std::span<std::int16_t> workRows;
+    ImageView<std::uint16_t> strength;
+    ImageView<std::uint16_t> derivativeStrength;
+  };
+
   DemuxLayout layout_;
+  int lanes_ = 1;
   const demux::Kernels* kernels_ = nullptr;  // the build of the vectorised stages run() calls
   std::span<std::uint16_t> predicted_;
   std::span<demux::UnitTable> units_;  // one table
@@ -139,8 +156,7 @@ class Demultiplexer {
   // smoothed row before it writes there).
   std::array<std::array<ImageView<std::int16_t>, 3>, kMaxProjectors> separated_;
   std::array<ImageView<std::uint8_t>, kMaxProjectors> order_;
-  ImageView<std::uint16_t> strength_;
-  ImageView<std::uint16_t> derivativeStrength_;
+  std::array<LaneScratch, kMaxProjectors> laneScratch_;
   std::array<BoundaryPlane, kMaxProjectors> boundaries_;
   std::array<DirectionPlane, kMaxProjectors> directions_;
 };

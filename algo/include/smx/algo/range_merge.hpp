@@ -40,6 +40,13 @@ namespace smx::algo {
 
 inline constexpr int kMaxRanges = 8;
 
+// Rows [begin, end) of the output (clipped to it). An output row reads only the input rows
+// beside it, so the merge cut into bands of rows gives the same planes, band by band at once.
+struct RowBand {
+  int begin = 0;
+  int end = 1 << 30;
+};
+
 // 1…kMaxRanges inputs, all the size of `out` (which may not alias them). A tolerance of
 // {65535, 0} lets every value agree: the paper's filter alone.
 [[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges, DepthPlane out,
@@ -48,11 +55,11 @@ inline constexpr int kMaxRanges = 8;
 // The same, with each range's confidence (depth_trust.hpp) and the merged confidence: the
 // smallest predicted error u = 255 − c among the ranges that agree with the reference at the
 // pixel, divided by √k for k of them (independent measurements; 256/√k rounded, Q8), as
-// 255 − u; 0 where the merged plane has no depth.
+// 255 − u; 0 where the merged plane has no depth. Only `rows` of both outputs are written.
 [[nodiscard]] Result<void> mergeRanges(std::span<const ConstDepthPlane> ranges,
                                        std::span<const ImageView<const std::uint8_t>> confidences,
                                        DepthPlane out, ImageView<std::uint8_t> outConfidence,
-                                       const DepthTolerance& tolerance = {});
+                                       const DepthTolerance& tolerance = {}, RowBand rows = {});
 
 // The same as the plain scalar definition, which the schedule above must equal bit for bit
 // (PipelineSchedule.* compares them); for the tests and the benchmarks.

@@ -117,17 +117,25 @@ struct SampleGrid {
 [[nodiscard]] SampleGrid sampleGrid(const DemuxLayout& layout);
 // rows: kHistogramRows working rows of the image's width (run() lends separate()'s).
 inline constexpr std::size_t kHistogramRows = 4;
+// Only the tiles of tile rows [firstTileRow, endTileRow) (clipped) are written: bands of tile
+// rows are independent, each with its own working rows.
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
                     const RowBlock<std::int32_t>& rows, std::span<std::uint32_t> tileHistograms,
-                    std::span<std::int32_t> tileMoments);
+                    std::span<std::int32_t> tileMoments, int firstTileRow, int endTileRow);
 
 // Stage 2b: lobes of each tile's window histogram matched to the predicted directions, then a
 // 3×3 median of the found tiles' offsets from the prediction; tiles without the lobe take their
-// neighbours'. out[p * tileCount + t]; scratch holds tileCount values.
-void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
-                        std::span<const std::int32_t> tileMoments,
-                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
-                        std::span<std::uint16_t> scratch);
+// neighbours'. out[p * tileCount + t]; scratch holds tileCount values. In two parts: the
+// matching, tile by tile (bands of tile rows [firstTileRow, endTileRow) are independent), then
+// what needs every tile's match.
+void matchTileLobes(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                    std::span<const std::int32_t> tileMoments,
+                    std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                    int firstTileRow, int endTileRow);
+void finishDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                      std::span<const std::int32_t> tileMoments,
+                      std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                      std::span<std::uint16_t> scratch);
 
 // Bilinear interpolation between tile centres (tile i's centre is pixel i·T + (T−1)/2), per
 // column or row: the lower tile, the upper one, the upper one's weight in 1/256 and the
@@ -211,7 +219,8 @@ void detectBoundaries(const Planes3& separated, ImageView<const std::uint8_t> or
 struct Kernels {
   decltype(&smoothChannels) smooth;
   decltype(&histogramTiles) histogram;
-  decltype(&estimateDirections) directions;
+  decltype(&matchTileLobes) lobes;
+  decltype(&finishDirections) finish;  // of the directions, after every band's lobes
   decltype(&interpolateDirections) interpolation;
   decltype(&separate) separation;
   decltype(&detectBoundaries) boundaries;
@@ -225,13 +234,15 @@ struct Kernels {
 namespace avx2 {
 using SmoothChannels = decltype(smoothChannels);
 using HistogramTiles = decltype(histogramTiles);
-using EstimateDirections = decltype(estimateDirections);
+using MatchTileLobes = decltype(matchTileLobes);
+using FinishDirections = decltype(finishDirections);
 using InterpolateDirections = decltype(interpolateDirections);
 using Separate = decltype(separate);
 using DetectBoundaries = decltype(detectBoundaries);
 SmoothChannels smoothChannels;
 HistogramTiles histogramTiles;
-EstimateDirections estimateDirections;
+MatchTileLobes matchTileLobes;
+FinishDirections finishDirections;
 InterpolateDirections interpolateDirections;
 Separate separate;
 DetectBoundaries detectBoundaries;

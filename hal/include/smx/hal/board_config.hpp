@@ -74,6 +74,8 @@ struct BoardConfig {
   std::optional<TurntableConfig> turntable{};  // none: the board has no turntable
   NetworkConfig network;
   double depthUnitM = 1e-4;
+  int threads = 0;         // decoding threads (0: one per camera)
+  bool pipelined = false;  // capture the next frame while the last decodes
   SimBoardConfig sim;
 };
 

@@ -1,5 +1,6 @@
-// Stage 2b, the schedule of estimateDirections() (reference: reference/directions.cpp): local
-// stripe-encoding directions (paper §3.2) from the tile histograms of histogram.cpp.
+// Stage 2b, the schedule of matchTileLobes() and finishDirections() (reference:
+// reference/directions.cpp): local stripe-encoding directions (paper §3.2) from the tile histograms
+// of histogram.cpp.
 //   Per tile window (windowTiles² tiles, sums in 64 bits): lobes are maxima of π/2-wide angle
 //   windows stepped by π/4 that are not at a window edge; each is refined by two mean-shift
 //   steps on the histogram (exact weighted mean of the samples in the bins within ±2 of the
@@ -486,12 +487,14 @@ void fillAbsentTiles(const DemuxLayout& layout, std::span<const std::uint16_t> p
 
 }  // namespace
 
-void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
-                        std::span<const std::int32_t> tileMoments,
-                        std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
-                        std::span<std::uint16_t> scratch) {
+void matchTileLobes(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                    std::span<const std::int32_t> tileMoments,
+                    std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                    int firstTileRow, int endTileRow) {
   const int tilesX = layout.tilesX();
   const int tilesY = layout.tilesY();
+  const int ty0 = firstTileRow < 0 ? 0 : firstTileRow;
+  const int ty1 = endTileRow > tilesY ? tilesY : endTileRow;
   const int r = layout.params.windowTiles / 2;
   const int projectors = layout.projectors;
   const std::size_t tileCount = layout.tileCount();
@@ -499,7 +502,7 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
   const auto minSharePct = static_cast<std::uint64_t>(layout.params.minLobeSharePct);
   WindowSums windows(tileHistograms, tileMoments, tilesX, tilesY, r);
 
-  for (int ty = 0; ty < tilesY; ++ty) {
+  for (int ty = ty0; ty < ty1; ++ty) {
     for (int tx = 0; tx < tilesX; ++tx) {
       const std::size_t tile = static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX) +
                                static_cast<std::size_t>(tx);
@@ -571,6 +574,12 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
       }
     }
   }
+}
+
+void finishDirections(const DemuxLayout& layout, std::span<const std::uint32_t> tileHistograms,
+                      std::span<const std::int32_t> tileMoments,
+                      std::span<const std::uint16_t> predicted, std::span<TileDirection> out,
+                      std::span<std::uint16_t> scratch) {
   growFoundTiles(layout, tileHistograms, tileMoments, predicted, out);
   // Twice: the second pass removes what clusters of stray tiles leave after the first.
   medianFilterTiles(layout, predicted, out, scratch);
@@ -579,13 +588,23 @@ void estimateDirections(const DemuxLayout& layout, std::span<const std::uint32_t
 }
 
 #if SMX_DEMUX_AVX2
-SMX_AVX2_TWIN void avx2::estimateDirections(const DemuxLayout& layout,
-                                            std::span<const std::uint32_t> tileHistograms,
-                                            std::span<const std::int32_t> tileMoments,
-                                            std::span<const std::uint16_t> predicted,
-                                            std::span<TileDirection> out,
-                                            std::span<std::uint16_t> scratch) {
-  demux::estimateDirections(layout, tileHistograms, tileMoments, predicted, out, scratch);
+SMX_AVX2_TWIN void avx2::matchTileLobes(const DemuxLayout& layout,
+                                        std::span<const std::uint32_t> tileHistograms,
+                                        std::span<const std::int32_t> tileMoments,
+                                        std::span<const std::uint16_t> predicted,
+                                        std::span<TileDirection> out, int firstTileRow,
+                                        int endTileRow) {
+  demux::matchTileLobes(layout, tileHistograms, tileMoments, predicted, out, firstTileRow,
+                        endTileRow);
+}
+
+SMX_AVX2_TWIN void avx2::finishDirections(const DemuxLayout& layout,
+                                          std::span<const std::uint32_t> tileHistograms,
+                                          std::span<const std::int32_t> tileMoments,
+                                          std::span<const std::uint16_t> predicted,
+                                          std::span<TileDirection> out,
+                                          std::span<std::uint16_t> scratch) {
+  demux::finishDirections(layout, tileHistograms, tileMoments, predicted, out, scratch);
 }
 #endif
 

@@ -74,7 +74,7 @@ SampleGrid sampleGrid(const DemuxLayout& layout) {
 
 void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
                     const RowBlock<std::int32_t>& rows, std::span<std::uint32_t> tileHistograms,
-                    std::span<std::int32_t> tileMoments) {
+                    std::span<std::int32_t> tileMoments, int firstTileRow, int endTileRow) {
   const SampleGrid grid = sampleGrid(layout);
   const int w = layout.width;
   const int h = layout.height;
@@ -83,16 +83,23 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
   const auto tilesX = static_cast<std::size_t>(layout.tilesX());
   const std::int32_t minGrad = layout.params.minGradientGrey * 2 * kSmoothScale;
   const std::int32_t minNorm2 = minGrad * minGrad;
-  for (auto& bin : tileHistograms) {
-    bin = 0;
+  const int tilesY = layout.tilesY();
+  const int ty0 = firstTileRow < 0 ? 0 : (firstTileRow > tilesY ? tilesY : firstTileRow);
+  const int ty1 = endTileRow < ty0 ? ty0 : (endTileRow > tilesY ? tilesY : endTileRow);
+  const std::size_t bandBegin = static_cast<std::size_t>(ty0) * tilesX * kBins;
+  const std::size_t bandEnd = static_cast<std::size_t>(ty1) * tilesX * kBins;
+  for (std::size_t i = bandBegin; i < bandEnd; ++i) {
+    tileHistograms[i] = 0;
+    tileMoments[i] = 0;
   }
-  for (auto& moment : tileMoments) {
-    moment = 0;
-  }
-  // Samples whose 5×5 support lies inside the image: x, y in [2, size − 3], multiples of s.
+  // Samples whose 5×5 support lies inside the image: x, y in [2, size − 3], multiples of s;
+  // here the sample rows of the band's tile rows.
   const int first = (2 + s - 1) / s * s;
   const int count = w - 2 > first ? (w - 3 - first) / s + 1 : 0;
-  for (int y = first; y + 2 < h; y += s) {
+  const int bandTop = ty0 * t;
+  const int yBegin = bandTop > first ? first + (bandTop - first + s - 1) / s * s : first;
+  const int yEnd = ty1 * t < h - 2 ? ty1 * t : h - 2;
+  for (int y = yBegin; y < yEnd; y += s) {
     for (std::size_t c = 0; c < 3; ++c) {
       gradientRow(smoothed[c], y, first, s, count, rows);
       // The samples at or above the threshold, compacted in place (n <= i), with their tile's
@@ -136,8 +143,10 @@ void histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
 SMX_AVX2_TWIN void avx2::histogramTiles(const Planes3& smoothed, const DemuxLayout& layout,
                                         const RowBlock<std::int32_t>& rows,
                                         std::span<std::uint32_t> tileHistograms,
-                                        std::span<std::int32_t> tileMoments) {
-  demux::histogramTiles(smoothed, layout, rows, tileHistograms, tileMoments);
+                                        std::span<std::int32_t> tileMoments, int firstTileRow,
+                                        int endTileRow) {
+  demux::histogramTiles(smoothed, layout, rows, tileHistograms, tileMoments, firstTileRow,
+                        endTileRow);
 }
 #endif
 

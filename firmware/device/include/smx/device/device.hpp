@@ -11,6 +11,7 @@
 
 #include "smx/algo/camera_pipeline.hpp"
 #include "smx/config/board_json.hpp"
+#include "smx/device/background_job.hpp"
 #include "smx/device/send_queue.hpp"
 #include "smx/device/worker_pool.hpp"
 #include "smx/hal/board_hal.hpp"
@@ -49,7 +50,12 @@ struct UpdateHooks {
 struct DeviceOptions {
   std::string firmwareVersion = "0.0.0";
   std::size_t queueSlots = 4;  // range frames waiting for the host (all cameras)
-  int decodeThreads = 0;       // cameras decoded in parallel (0: one thread per camera)
+  // Decoding threads (0: board.json's `threads`, else one per camera): the cameras in
+  // parallel, and threads beyond one per camera split each camera's frame.
+  int decodeThreads = 0;
+  // The capture of the next frame overlaps the decoding of the last (board.json's `pipelined`):
+  // more frames per second, each still as soon as it is decoded.
+  bool pipelined = false;
   std::int64_t acquireTimeoutNs = 2'000'000'000;
   // A host that sends nothing while not streaming, or reads nothing while the device has data
   // for it, for this long is disconnected so that another can use the device (0: never).
@@ -93,8 +99,12 @@ class Device {
   Device& operator=(const Device&) = delete;
 
   // One capture: trigger, acquire every camera, decode, queue (while a host streams). A camera
-  // error is counted and returned; the caller goes on with the next capture.
+  // error is counted and returned; the caller goes on with the next capture. Pipelined, the
+  // capture is decoded in the background while the next one is taken: captureOnce() returns
+  // once the previous capture is decoded and this one's decoding has begun.
   [[nodiscard]] hal::HalResult<void> captureOnce();
+  // Pipelined: waits for the capture being decoded and gives its frames back to the cameras.
+  void finishCapture();
   // Serves a raw capture the host asked for, if one waits: lights the asked projectors, takes
   // one frame per camera and leaves the bands (or an error) for the network loop to send.
   // Returns whether one was served. Allocation-free.
@@ -134,9 +144,21 @@ class Device {
     std::vector<std::byte> memory;
     std::unique_ptr<algo::Arena> arena;
     std::unique_ptr<algo::CameraPipeline> pipeline;
+    std::unique_ptr<WorkerPool> jobs;  // the parts of one frame
   };
 
   Device(const config::Board& board, hal::Hal hal, const DeviceOptions& options);
+  struct Acquired {
+    hal::HalResult<void> status;
+    std::size_t count = 0;    // frames borrowed, from the first camera on
+    bool triggered = false;   // the lines were lit
+    std::string_view failed;  // what failed: "trigger lines" or the camera's id
+  };
+  // Lights `mask` and borrows one frame per camera into `frames`.
+  Acquired acquireFrames(std::uint32_t mask, std::vector<hal::CameraFrame>& frames);
+  void releaseFrames(const std::vector<hal::CameraFrame>& frames, std::size_t count) const;
+  // Decodes (and queues) frames_[0, decodingCount_) as capture decodingNumber_.
+  void decodeFrames();
   void decodeCamera(int camera);
   void queueRangeFrame(int camera, const hal::CameraFrame& frame, std::uint32_t decodeUs);
   // Captures with `mask` lit and writes the bands of every camera into raw_; returns their size
@@ -165,8 +187,15 @@ class Device {
   std::int64_t leadNs_;
   std::int64_t startNs_;
   std::vector<CameraSlot> cameras_;
-  std::vector<hal::CameraFrame> frames_;  // this capture's borrowed frames, per camera
+  std::vector<hal::CameraFrame> frames_;  // the borrowed frames being decoded, per camera
+  std::vector<hal::CameraFrame> next_;    // pipelined: the capture taken meanwhile
+  std::size_t decodingCount_ = 0;         // frames_ in use
+  std::uint64_t decodingNumber_ = 0;      // their capture's number
   std::unique_ptr<WorkerPool> workers_;
+  std::unique_ptr<BackgroundJob> decoding_;  // pipelined only
+  std::int64_t framePeriodNs_ = 0;           // of the fastest camera, as configured
+  std::int64_t decodeStartNs_ = 0;
+  std::atomic<std::int64_t> lastDecodeNs_ = 0;  // written by the decoding thread
   std::uint64_t captureNumber_ = 0;
   DeviceCounters counters_;
   SendQueue queue_;

@@ -6,26 +6,27 @@
 #include <thread>
 #include <vector>
 
+#include "smx/algo/jobs.hpp"
+
 // Runs job(i) for i in [0, count) on the calling thread and a fixed set of workers started at
-// construction: the capture loop decodes its cameras in parallel. Dispatch takes a plain function
-// pointer and context, so a frame's work allocates nothing.
+// construction: the capture loop decodes its cameras in parallel, and each camera's pipeline
+// hands the parts of one frame to a pool of its own. Dispatch takes a plain function pointer and
+// context, so a frame's work allocates nothing.
 namespace smx::device {
 
-class WorkerPool {
+class WorkerPool final : public algo::JobRunner {
  public:
   explicit WorkerPool(int workers);
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
+  WorkerPool(WorkerPool&&) = delete;
+  WorkerPool& operator=(WorkerPool&&) = delete;
 
-  template <class Job>
-  void run(int count, Job& job) {
-    runRaw(count, &job, [](void* context, int index) { (*static_cast<Job*>(context))(index); });
-  }
+  void runJobs(int count, void* context, Call call) override;
+  [[nodiscard]] int width() const override { return static_cast<int>(workers_.size()) + 1; }
 
  private:
-  using Call = void (*)(void*, int);
-  void runRaw(int count, void* context, Call call);
   void workerLoop();
   // Takes the next index of the current batch; false when none is left.
   bool runNext(std::unique_lock<std::mutex>& lock);
