@@ -45,7 +45,7 @@ void Device::releaseFrames(const std::vector<hal::CameraFrame>& frames, std::siz
 
 // A failed capture returns with nothing decoding, so that recover() may take back every buffer.
 hal::HalResult<void> Device::captureOnce() {
-  // Pipelined, the capture goes to next_ while frames_ may still be decoding: just in time, the
+  // The capture goes to next_, as frames_ may still be decoding. Pipelined, just in time: the
   // frame that arrives as the decoding ends, not one that would wait a whole decode for it.
   if (decoding_ && decodingCount_ > 0) {
     const std::int64_t ready = decodeStartNs_ + lastDecodeNs_ - framePeriodNs_;
@@ -53,18 +53,15 @@ hal::HalResult<void> Device::captureOnce() {
       hal_.clock.sleepUntilNs(ready);
     }
   }
-  std::vector<hal::CameraFrame>& into = decoding_ ? next_ : frames_;
-  const Acquired got = acquireFrames(rangeProjectorsMask_, into);
+  const Acquired got = acquireFrames(rangeProjectorsMask_, next_);
   finishCapture();
   if (!got.status) {
     ++counters_.captureErrors;
-    releaseFrames(into, got.count);
+    releaseFrames(next_, got.count);
     captureNumber_ += got.triggered ? 1 : 0;
     return got.status;
   }
-  if (decoding_) {
-    std::swap(frames_, next_);  // the new capture is the one to decode
-  }
+  std::swap(frames_, next_);  // the new capture is the one to decode
   decodingCount_ = got.count;
   decodingNumber_ = captureNumber_++;
   decodeStartNs_ = hal_.clock.nowNs();

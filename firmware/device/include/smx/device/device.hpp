@@ -188,7 +188,7 @@ class Device {
   std::int64_t startNs_;
   std::vector<CameraSlot> cameras_;
   std::vector<hal::CameraFrame> frames_;  // the borrowed frames being decoded, per camera
-  std::vector<hal::CameraFrame> next_;    // pipelined: the capture taken meanwhile
+  std::vector<hal::CameraFrame> next_;    // the capture being taken
   std::size_t decodingCount_ = 0;         // frames_ in use
   std::uint64_t decodingNumber_ = 0;      // their capture's number
   std::unique_ptr<WorkerPool> workers_;
