@@ -260,63 +260,73 @@ TEST(PipelineSchedule, LanesBeyondTheProjectorsAreRefused) {
 
 // Range images that take the merge's every branch: one smooth surface measured by up to eight
 // ranges with noise, holes, outliers and values on a quantised grid (equal variances: unions),
-// and the filter's jumps; the image sizes leave no border unvisited.
+// and the filter's jumps; the image sizes leave no border unvisited. Dense ranges on a wide
+// image give full windows (taken whole, in unions too) across the schedule's chunks of columns.
 TEST(PipelineSchedule, MergeAndEdgeFilterGiveTheReferenceOnRandomRanges) {
   std::mt19937 rng(7);
-  for (const int ranges : {1, 2, 3, 5, 8}) {
-    for (const int quantum : {1, 8}) {
-      SCOPED_TRACE(std::to_string(ranges) + " ranges, quantum " + std::to_string(quantum));
-      const int w = 37;
-      const int h = 23;
-      const auto pixels = static_cast<std::size_t>(w * h);
-      std::vector<std::vector<std::uint16_t>> depth(static_cast<std::size_t>(ranges));
-      std::vector<std::vector<std::uint8_t>> confidence(static_cast<std::size_t>(ranges));
-      std::vector<ConstDepthPlane> views;
-      std::vector<ImageView<const std::uint8_t>> confidenceViews;
-      std::uniform_int_distribution<int> noise(-20, 20);
-      std::uniform_int_distribution<int> percent(0, 99);
-      for (std::size_t r = 0; r < depth.size(); ++r) {
-        depth[r].resize(pixels);
-        confidence[r].resize(pixels);
-        for (std::size_t i = 0; i < pixels; ++i) {
-          const int x = static_cast<int>(i) % w;
-          const int roll = percent(rng);
-          int z = 9000 + 15 * x + noise(rng);
-          z = z / quantum * quantum;
-          if (roll < 20) {
-            z = kNoDepth;
-          } else if (roll < 30) {
-            z = 6000 + 40 * noise(rng);  // an outlier or another surface
+  struct Holes {
+    int width;
+    int missingPct;
+    int outlierPct;
+  };
+  for (const Holes holes : {Holes{37, 20, 10}, Holes{150, 2, 2}}) {
+    for (const int ranges : {1, 2, 3, 5, 8}) {
+      for (const int quantum : {1, 8, 64}) {
+        SCOPED_TRACE(std::to_string(ranges) + " ranges, quantum " + std::to_string(quantum) +
+                     ", width " + std::to_string(holes.width));
+        const int w = holes.width;
+        const int h = 23;
+        const auto pixels = static_cast<std::size_t>(w * h);
+        std::vector<std::vector<std::uint16_t>> depth(static_cast<std::size_t>(ranges));
+        std::vector<std::vector<std::uint8_t>> confidence(static_cast<std::size_t>(ranges));
+        std::vector<ConstDepthPlane> views;
+        std::vector<ImageView<const std::uint8_t>> confidenceViews;
+        std::uniform_int_distribution<int> noise(-20, 20);
+        std::uniform_int_distribution<int> percent(0, 99);
+        for (std::size_t r = 0; r < depth.size(); ++r) {
+          depth[r].resize(pixels);
+          confidence[r].resize(pixels);
+          for (std::size_t i = 0; i < pixels; ++i) {
+            const int x = static_cast<int>(i) % w;
+            const int roll = percent(rng);
+            int z = 9000 + 15 * x + noise(rng);
+            z = z / quantum * quantum;
+            if (roll < holes.missingPct) {
+              z = kNoDepth;
+            } else if (roll < holes.missingPct + holes.outlierPct) {
+              z = 6000 + 40 * noise(rng);  // an outlier or another surface
+            }
+            depth[r][i] = static_cast<std::uint16_t>(z);
+            confidence[r][i] = static_cast<std::uint8_t>(z == kNoDepth ? 0 : 1 + percent(rng) * 2);
           }
-          depth[r][i] = static_cast<std::uint16_t>(z);
-          confidence[r][i] = static_cast<std::uint8_t>(z == kNoDepth ? 0 : 1 + percent(rng) * 2);
+          views.push_back(*ConstDepthPlane::packed(depth[r], w, h));
+          confidenceViews.push_back(*ImageView<const std::uint8_t>::packed(confidence[r], w, h));
         }
-        views.push_back(*ConstDepthPlane::packed(depth[r], w, h));
-        confidenceViews.push_back(*ImageView<const std::uint8_t>::packed(confidence[r], w, h));
-      }
-      std::vector<std::uint16_t> merged(pixels);
-      std::vector<std::uint16_t> mergedReference(pixels);
-      std::vector<std::uint8_t> mergedConfidence(pixels);
-      std::vector<std::uint8_t> mergedConfidenceReference(pixels);
-      const DepthTolerance tolerance{50, 10};
-      ASSERT_TRUE(mergeRanges(views, confidenceViews, *DepthPlane::packed(merged, w, h),
-                              *ImageView<std::uint8_t>::packed(mergedConfidence, w, h), tolerance));
-      ASSERT_TRUE(mergeRangesReference(
-          views, confidenceViews, *DepthPlane::packed(mergedReference, w, h),
-          *ImageView<std::uint8_t>::packed(mergedConfidenceReference, w, h), tolerance));
-      EXPECT_EQ(merged, mergedReference);
-      EXPECT_EQ(mergedConfidence, mergedConfidenceReference);
-      EXPECT_GT(std::count_if(merged.begin(), merged.end(),
-                              [](std::uint16_t z) { return z != kNoDepth; }),
-                static_cast<std::ptrdiff_t>(pixels / 4));
+        std::vector<std::uint16_t> merged(pixels);
+        std::vector<std::uint16_t> mergedReference(pixels);
+        std::vector<std::uint8_t> mergedConfidence(pixels);
+        std::vector<std::uint8_t> mergedConfidenceReference(pixels);
+        const DepthTolerance tolerance{50, 10};
+        ASSERT_TRUE(mergeRanges(views, confidenceViews, *DepthPlane::packed(merged, w, h),
+                                *ImageView<std::uint8_t>::packed(mergedConfidence, w, h),
+                                tolerance));
+        ASSERT_TRUE(mergeRangesReference(
+            views, confidenceViews, *DepthPlane::packed(mergedReference, w, h),
+            *ImageView<std::uint8_t>::packed(mergedConfidenceReference, w, h), tolerance));
+        EXPECT_EQ(merged, mergedReference);
+        EXPECT_EQ(mergedConfidence, mergedConfidenceReference);
+        EXPECT_GT(std::count_if(merged.begin(), merged.end(),
+                                [](std::uint16_t z) { return z != kNoDepth; }),
+                  static_cast<std::ptrdiff_t>(pixels / 4));
 
-      for (const int permille : {0, 5, 20, 1000}) {
-        std::vector<std::uint16_t> kept(pixels);
-        std::vector<std::uint16_t> keptReference(pixels);
-        ASSERT_TRUE(removeDepthEdges(views[0], *DepthPlane::packed(kept, w, h), permille));
-        ASSERT_TRUE(removeDepthEdgesReference(views[0], *DepthPlane::packed(keptReference, w, h),
-                                              permille));
-        EXPECT_EQ(kept, keptReference) << permille << " per mille";
+        for (const int permille : {0, 5, 20, 1000}) {
+          std::vector<std::uint16_t> kept(pixels);
+          std::vector<std::uint16_t> keptReference(pixels);
+          ASSERT_TRUE(removeDepthEdges(views[0], *DepthPlane::packed(kept, w, h), permille));
+          ASSERT_TRUE(removeDepthEdgesReference(views[0], *DepthPlane::packed(keptReference, w, h),
+                                                permille));
+          EXPECT_EQ(kept, keptReference) << permille << " per mille";
+        }
       }
     }
   }

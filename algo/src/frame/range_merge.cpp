@@ -1,8 +1,9 @@
 // The median-variant merge (range_merge.hpp; paper §4.2, "data merging stage": the ranges of
 // the separated patterns merged per image). merge<true> is the plain scalar definition,
 // merge<false> the schedule: the same sets and median, reached with fewer steps (pixels without
-// depth passed over, agreeing full windows taken whole, sets gathered in place, the median by
-// a network or by selection instead of sorting).
+// depth passed over, each row's 3 × 1 columns sorted and summed once for the three windows that
+// hold them, agreeing full windows taken whole from their columns, sets gathered in place, the
+// median by selection instead of sorting).
 #include "smx/algo/range_merge.hpp"
 
 #include <algorithm>
@@ -68,47 +69,75 @@ std::uint16_t medianBySelection(std::array<std::uint16_t, kMaxValues>& v, std::s
   return static_cast<std::uint16_t>((std::uint32_t{below} + *middle + 1) / 2);
 }
 
-// The median of v[0 … 9) by a selection network of 19 exchanges (after Paeth; Devillard's
-// opt_med9), on a copy.
-std::uint16_t medianOfNine(const std::array<std::uint16_t, kMaxValues>& v) {
-  std::array<std::uint16_t, kWindow> p{};
-  std::copy_n(v.begin(), kWindow, p.begin());
-  const auto order = [&p](std::size_t a, std::size_t b) {
-    const std::uint16_t lo = std::min(p[a], p[b]);
-    p[b] = std::max(p[a], p[b]);
-    p[a] = lo;
-  };
-  order(1, 2), order(4, 5), order(7, 8), order(0, 1), order(3, 4), order(6, 7);
-  order(1, 2), order(4, 5), order(7, 8), order(0, 3), order(5, 8), order(4, 7);
-  order(3, 6), order(1, 4), order(2, 5), order(4, 7), order(4, 2), order(6, 4);
-  order(4, 2);
-  return p[4];
+// The schedule's 3 × 1 column of one range at one column of the row: its values sorted, their sum
+// and sum of squares. A 3 × 3 window is three columns side by side, and its extremes, sums and
+// median follow from theirs, each column computed once for the three windows that hold it.
+struct Column {
+  std::uint16_t lo;
+  std::uint16_t mid;
+  std::uint16_t hi;
+  std::int32_t sum;
+  std::int64_t squares;
+};
+
+// The columns of one chunk of a row: column cx − 1 + k at index k.
+constexpr int kChunk = 64;
+using ChunkColumns = std::array<Column, kChunk + 2>;
+
+// Columns first … last (inside the image) of range r around inner row y, for the chunk at cx.
+void fillColumns(const ConstDepthPlane& r, int y, int cx, int first, int last,
+                 ChunkColumns& columns) {
+  const std::uint16_t* above = r.rowPtr(y - 1);
+  const std::uint16_t* at = r.rowPtr(y);
+  const std::uint16_t* below = r.rowPtr(y + 1);
+  for (int c = first; c <= last; ++c) {
+    const std::int32_t a = above[c];
+    const std::int32_t b = at[c];
+    const std::int32_t d = below[c];
+    const std::int32_t lo = std::min(std::min(a, b), d);
+    const std::int32_t hi = std::max(std::max(a, b), d);
+    const std::int32_t sum = a + b + d;
+    columns[static_cast<std::size_t>(c - cx + 1)] = {
+        static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(sum - lo - hi),
+        static_cast<std::uint16_t>(hi), sum,
+        std::int64_t{a} * a + std::int64_t{b} * b + std::int64_t{d} * d};
+  }
 }
 
-// A window inside the image whose nine values all lie in [low, low + span] (so none is
-// kNoDepth): its values into `values` and their count and sums into `set`; false otherwise.
-bool fullWindow(const ConstDepthPlane& r, int x, int y, std::int32_t low, std::uint32_t span,
-                std::uint16_t* values, Set& set) {
-  std::int32_t lo = 65535;
-  std::int32_t hi = 0;
-  std::int64_t sum = 0;
-  std::int64_t squares = 0;
-  for (int dy = -1; dy <= 1; ++dy) {
-    const std::uint16_t* row = r.rowPtr(y + dy) + x;
-    for (int dx = -1; dx <= 1; ++dx) {
-      const std::int32_t z = row[dx];
-      lo = std::min(lo, z);
-      hi = std::max(hi, z);
-      sum += z;
-      squares += std::int64_t{z} * z;
-      values[static_cast<std::size_t>(3 * (dy + 1) + dx + 1)] = static_cast<std::uint16_t>(z);
-    }
-  }
+std::int32_t medianOfThree(std::int32_t a, std::int32_t b, std::int32_t c) {
+  return std::max(std::min(a, b), std::min(std::max(a, b), c));
+}
+
+// The median of the window whose columns are c[0], c[1], c[2]: of nine values, it is the median
+// of the largest column minimum, the median column median and the smallest column maximum.
+std::uint16_t medianOfColumns(const Column* c) {
+  const std::int32_t lows = std::max(std::max(c[0].lo, c[1].lo), c[2].lo);
+  const std::int32_t mids = medianOfThree(c[0].mid, c[1].mid, c[2].mid);
+  const std::int32_t highs = std::min(std::min(c[0].hi, c[1].hi), c[2].hi);
+  return static_cast<std::uint16_t>(medianOfThree(lows, mids, highs));
+}
+
+// The window whose columns are c[0 … 3) as a set when all nine values lie in [low, low + span]
+// (so none is kNoDepth); false otherwise.
+bool fullWindow(const Column* c, std::int32_t low, std::uint32_t span, Set& set) {
+  const std::int32_t lo = std::min(std::min(c[0].lo, c[1].lo), c[2].lo);
+  const std::int32_t hi = std::max(std::max(c[0].hi, c[1].hi), c[2].hi);
   if (lo < low || static_cast<std::uint32_t>(hi - low) > span) {
     return false;
   }
-  set = {kWindow, sum, squares};
+  set = {kWindow, std::int64_t{c[0].sum} + c[1].sum + c[2].sum,
+         c[0].squares + c[1].squares + c[2].squares};
   return true;
+}
+
+// The nine values of range r's window at inner pixel (x, y) into v.
+void gatherWindow(const ConstDepthPlane& r, int x, int y, std::uint16_t* v) {
+  for (int dy = -1; dy <= 1; ++dy) {
+    const std::uint16_t* row = r.rowPtr(y + dy) + x;
+    for (int dx = -1; dx <= 1; ++dx) {
+      *v++ = row[dx];
+    }
+  }
 }
 
 // 256 / √k, rounded: the predicted error of the mean of k agreeing ranges (Q8), k = 0…8.
@@ -192,108 +221,134 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
   const std::size_t n = ranges.size();
   // The chosen members are gathered at the front of `chosen`. The reference gathers each new
   // set in `next` and copies it in when the fold keeps it (alone or in a union); the schedule
-  // gathers it right behind the chosen members, where a union already has it.
+  // gathers it right behind the chosen members, where a union already has it. A full window the
+  // schedule keeps whole stays ungathered (`lazy`: its range) until a union needs its values.
   std::array<std::uint16_t, kMaxValues> chosen{};
   std::array<std::uint16_t, kWindow> next{};
   std::array<std::uint16_t, kMaxRanges> centre{};
+  std::array<ChunkColumns, kMaxRanges> columns{};
   const int yEnd = rows.end < h ? rows.end : h;
   for (int y = rows.begin > 0 ? rows.begin : 0; y < yEnd; ++y) {
     std::uint16_t* o = out.rowPtr(y);
     std::uint8_t* oc = outConfidence != nullptr ? outConfidence->rowPtr(y) : nullptr;
     const int y0 = y > 0 ? y - 1 : 0;
     const int y1 = y + 1 < h ? y + 1 : h - 1;
-    for (int x = 0; x < w; ++x) {
-      o[x] = kNoDepth;
-      if (oc != nullptr) {
-        oc[x] = 0;
-      }
-      std::uint32_t any = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        centre[i] = ranges[i].rowPtr(y)[x];
-        any |= centre[i];
-      }
-      if (!kReference && any == kNoDepth) {
-        continue;
-      }
-      const std::uint16_t ref = reference(centre, n, tolerance);
-      if (ref == kNoDepth) {
-        continue;
-      }
-      // z within [ref − tol, ref + tol] and not kNoDepth, in one unsigned comparison.
-      const std::int32_t tol = tolerance.at(ref);
-      const std::int32_t low = ref > tol ? ref - tol : 1;
-      const auto span = static_cast<std::uint32_t>(ref + tol - low);
-      const auto agrees = [low, span](std::uint16_t z) {
-        return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
-      };
-      const int x0 = x > 0 ? x - 1 : 0;
-      const int x1 = x + 1 < w ? x + 1 : w - 1;
-      const bool inner = x > 0 && y > 0 && x + 1 < w && y + 1 < h;
-      Set best;
-      std::int32_t error = 255;
-      int agreeing = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        if (centre[i] != kNoDepth && !agrees(centre[i])) {
-          continue;  // outvoted
+    const bool innerRow = !kReference && y > 0 && y + 1 < h;
+    for (int cx = 0; cx < w; cx += kChunk) {
+      const int cxEnd = cx + kChunk < w ? cx + kChunk : w;
+      if (innerRow) {
+        for (std::size_t i = 0; i < n; ++i) {
+          fillColumns(ranges[i], y, cx, cx > 0 ? cx - 1 : 0, cxEnd < w ? cxEnd : w - 1, columns[i]);
         }
-        if (oc != nullptr && centre[i] != kNoDepth) {
-          const std::int32_t e = 255 - confidences[i].rowPtr(y)[x];
-          error = e < error ? e : error;
-          ++agreeing;
+      }
+      for (int x = cx; x < cxEnd; ++x) {
+        o[x] = kNoDepth;
+        if (oc != nullptr) {
+          oc[x] = 0;
         }
-        const ConstDepthPlane& r = ranges[i];
-        std::uint16_t* gathered =
-            kReference ? next.data() : chosen.data() + static_cast<std::size_t>(best.count);
-        Set set;
-        // The schedule takes a full 3 × 3 window that agrees throughout without a branch per
-        // value: its extremes tell.
-        const bool full = !kReference && inner && fullWindow(r, x, y, low, span, gathered, set);
-        if (!full) {
-          for (int yy = y0; yy <= y1; ++yy) {
-            const std::uint16_t* row = r.rowPtr(yy);
-            for (int xx = x0; xx <= x1; ++xx) {
-              const std::uint16_t z = row[xx];
-              if (agrees(z)) {
-                gathered[set.count++] = z;
-                set.sum += z;
-                set.sumSquares += std::int64_t{z} * z;
+        std::uint32_t any = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          centre[i] = ranges[i].rowPtr(y)[x];
+          any |= centre[i];
+        }
+        if (!kReference && any == kNoDepth) {
+          continue;
+        }
+        const std::uint16_t ref = reference(centre, n, tolerance);
+        if (ref == kNoDepth) {
+          continue;
+        }
+        // z within [ref − tol, ref + tol] and not kNoDepth, in one unsigned comparison.
+        const std::int32_t tol = tolerance.at(ref);
+        const std::int32_t low = ref > tol ? ref - tol : 1;
+        const auto span = static_cast<std::uint32_t>(ref + tol - low);
+        const auto agrees = [low, span](std::uint16_t z) {
+          return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
+        };
+        const int x0 = x > 0 ? x - 1 : 0;
+        const int x1 = x + 1 < w ? x + 1 : w - 1;
+        const bool inner = innerRow && x > 0 && x + 1 < w;
+        const auto windowColumns = [&](std::size_t i) {
+          return &columns[i][static_cast<std::size_t>(x - cx)];
+        };
+        Set best;
+        std::size_t lazy = kMaxRanges;  // none
+        std::int32_t error = 255;
+        int agreeing = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (centre[i] != kNoDepth && !agrees(centre[i])) {
+            continue;  // outvoted
+          }
+          if (oc != nullptr && centre[i] != kNoDepth) {
+            const std::int32_t e = 255 - confidences[i].rowPtr(y)[x];
+            error = e < error ? e : error;
+            ++agreeing;
+          }
+          const ConstDepthPlane& r = ranges[i];
+          std::uint16_t* gathered =
+              kReference ? next.data() : chosen.data() + static_cast<std::size_t>(best.count);
+          Set set;
+          // The schedule takes a full 3 × 3 window that agrees throughout without a branch per
+          // value: its columns' extremes tell.
+          const bool full = inner && fullWindow(windowColumns(i), low, span, set);
+          if (!full) {
+            for (int yy = y0; yy <= y1; ++yy) {
+              const std::uint16_t* row = r.rowPtr(yy);
+              for (int xx = x0; xx <= x1; ++xx) {
+                const std::uint16_t z = row[xx];
+                if (agrees(z)) {
+                  gathered[set.count++] = z;
+                  set.sum += z;
+                  set.sumSquares += std::int64_t{z} * z;
+                }
               }
             }
           }
-        }
-        if (set.count == 0) {
-          continue;
-        }
-        int keep = 0;  // −1: the running choice, 1: the new set, 0: both
-        if (best.count == 0 || set.count - best.count > 3) {
-          keep = 1;
-        } else if (best.count - set.count > 3) {
-          keep = -1;
-        } else {
-          keep = compareVariance(best, set);
-        }
-        if (keep < 0) {
-          continue;
-        }
-        const auto at = static_cast<std::size_t>(keep == 0 ? best.count : 0);
-        if (gathered != chosen.data() + at) {
-          // Ascending: where the schedule moves a set to the front, the ranges may overlap.
-          for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
-            chosen[at + k] = gathered[k];
+          if (set.count == 0) {
+            continue;
           }
+          int keep = 0;  // −1: the running choice, 1: the new set, 0: both
+          if (best.count == 0 || set.count - best.count > 3) {
+            keep = 1;
+          } else if (best.count - set.count > 3) {
+            keep = -1;
+          } else {
+            keep = compareVariance(best, set);
+          }
+          if (keep < 0) {
+            continue;
+          }
+          const auto at = static_cast<std::size_t>(keep == 0 ? best.count : 0);
+          if (keep == 0 && lazy < kMaxRanges) {
+            gatherWindow(ranges[lazy], x, y, chosen.data());
+          }
+          if (full) {
+            if (keep == 0) {
+              gatherWindow(r, x, y, chosen.data() + at);
+            }
+          } else if (gathered != chosen.data() + at) {
+            // Ascending: where the schedule moves a set to the front, the ranges may overlap.
+            for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
+              chosen[at + k] = gathered[k];
+            }
+          }
+          lazy = keep == 1 && full ? i : kMaxRanges;
+          best = keep == 0 ? Set{best.count + set.count, best.sum + set.sum,
+                                 best.sumSquares + set.sumSquares}
+                           : set;
         }
-        best = keep == 0 ? Set{best.count + set.count, best.sum + set.sum,
-                               best.sumSquares + set.sumSquares}
-                         : set;
-      }
-      const auto count = static_cast<std::size_t>(best.count);
-      o[x] = kReference
-                 ? medianBySorting(chosen, count)
-                 : (count == kWindow ? medianOfNine(chosen) : medianBySelection(chosen, count));
-      if (oc != nullptr) {
-        const std::int32_t e =
-            (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
-        oc[x] = static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+        const auto count = static_cast<std::size_t>(best.count);
+        if constexpr (kReference) {
+          o[x] = medianBySorting(chosen, count);
+        } else {
+          o[x] = lazy < kMaxRanges ? medianOfColumns(windowColumns(lazy))
+                                   : medianBySelection(chosen, count);
+        }
+        if (oc != nullptr) {
+          const std::int32_t e =
+              (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
+          oc[x] = static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+        }
       }
     }
   }
