@@ -34,7 +34,6 @@ using decode::Unit;
 using decode::unitOf;
 using decode::walk;
 using decode::walkSkippingEmpty;
-using decode::walkTable;
 
 namespace {
 
@@ -119,9 +118,8 @@ Result<void> StripeDecoder::carve(Carver& carver) {
     }
   };
   step(carveSpan(carver, units_, 1));
-  const std::size_t walkSteps = 2 * static_cast<std::size_t>(params_.maxGapPx) + 1;
-  step(carveSpan(carver, fillBlocks_, demux::UnitTable::kEntries * walkSteps));
-  step(carveSpan(carver, fillBlockCount_, demux::UnitTable::kEntries));
+  step(carveSpan(carver, line_, static_cast<std::size_t>(width_ > height_ ? width_ : height_)));
+  step(carveSpan(carver, axis_, pixels));
   step(carveSpan(carver, code_, pixels));
   step(carveSpan(carver, shift_, pixels));
   step(carveSpan(carver, next_, pixels));
@@ -169,13 +167,6 @@ Result<StripeDecoder> StripeDecoder::create(int width, int height, const DecodeP
     return std::unexpected(ok.error());
   }
   d.units_[0].fill();
-  // The fill's walks per direction entry e (angle 64 e: cosOf and sinOf read entries e, e − 256).
-  for (int e = 0; e < demux::UnitTable::kEntries; ++e) {
-    const Unit u = unitOf(d.units_[0], static_cast<std::uint16_t>(e * 64));
-    const auto entry = static_cast<std::size_t>(e);
-    d.fillBlockCount_[entry] = static_cast<std::uint8_t>(
-        decode::blockSteps(-(u.x >> 7), -(u.y >> 7), 2 * params.maxGapPx, d.fillBlocksOf(entry)));
-  }
   for (auto& level : d.level_) {
     level = 0;
   }
@@ -206,13 +197,7 @@ void StripeDecoder::runSteps(ConstDirectionPlane d, StripePlane stripe) {
   vote<kReference>();
   joinCurves<kReference>();
   smoothPositions<kReference>(d);
-  fill<kReference>(d, stripe);
-}
-
-// The slots of direction entry `entry` in fillBlocks_.
-std::span<decode::BlockStep> StripeDecoder::fillBlocksOf(std::size_t entry) const {
-  const std::size_t perWalk = 2 * static_cast<std::size_t>(params_.maxGapPx) + 1;
-  return fillBlocks_.subspan(entry * perWalk, perWalk);
+  fill(d, stripe);
 }
 
 // Each boundary's class and sub-pixel shift in flat planes (the walks below read them many
@@ -607,94 +592,131 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
   }
 }
 
-// The schedule's pass-over for step 4: total_ (free after step 3) becomes the inclusive integral
-// image of the decoded boundary pixels (at most 8192² = 2^26 of them: int32).
-void StripeDecoder::integrateDecoded() {
+// Step 4. Every row, then every column, as a scan line; each pixel takes the kind of line nearer
+// its own axis (a row when the axis lies within 45° of x), which a boundary curve crosses with a
+// pixel on it (an 8-connected curve within 45° of the line's normal has a pixel on every line it
+// spans). A curve missing its pixel on a line leaves that line's pixels beside it without a
+// coordinate: filling them from the neighbouring line (as the walks of step 1 look at 2 × 2 blocks)
+// gives more coordinates but more wrong ones (docs/decode.md).
+void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
+  int rowPixels = 0;
   for (int y = 0; y < height_; ++y) {
-    std::int32_t rowSum = 0;
+    StripeQ16* out = stripe.rowPtr(y);
+    const std::uint16_t* dirs = d.rowPtr(y);
+    std::uint8_t* axis = &axis_[flat(0, y, width_)];
     for (int x = 0; x < width_; ++x) {
-      const std::size_t i = flat(x, y, width_);
-      rowSum += level_[i] != 0 ? 1 : 0;
-      total_[i] = rowSum + (y > 0 ? total_[i - static_cast<std::size_t>(width_)] : 0);
+      out[x] = kNoStripe;
+      // Within 45° of ±x: the angle (2^16 a turn) plus an eighth turn, modulo a half turn, lies
+      // in the first quarter turn.
+      const bool row = ((dirs[x] + 8192U) & 32767U) < 16384U;
+      axis[x] = row ? kRowAxis : kColumnAxis;
+      rowPixels += row ? 1 : 0;
+    }
+  }
+  if (rowPixels > 0) {
+    for (int y = 0; y < height_; ++y) {
+      fillLine(d, stripe, kRowAxis, width_, [y](int t) { return PixelXY{t, y}; });
+    }
+  }
+  if (rowPixels < width_ * height_) {
+    for (int x = 0; x < width_; ++x) {
+      fillLine(d, stripe, kColumnAxis, height_, [x](int t) { return PixelXY{x, t}; });
     }
   }
 }
 
-// Step 4. Walk back along the pixel's own axis to the nearest boundary at or behind it; the
-// pixel lies between that boundary and its forward link when their levels are consecutive.
-template <bool kReference>
-void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
+// One scan line of step 4: `length` pixels, pixel t at pixelAt(t). The line's boundary pixels,
+// in order, form groups: runs of adjacent pixels of one class, one boundary crossing the line. A
+// group's level is its decoded pixels' level (0 when they disagree or none is decoded), its
+// position their mean position (all lie on the boundary). Between two consecutive groups whose
+// levels are k and k + 1 (in either order) lie the pixels from the first group to the second;
+// each of them whose axis takes this kind of line gets s = k + first / between along its own
+// axis u: first = (pixel − q) · u, between = (n − q) · u, q and n the positions of the level-k and
+// level-k + 1 groups, when 0 ≤ first < between ≤ maxGapPx + 1 px (a group's pixel lies between
+// two pairs; the first that holds it wins). An undecoded boundary (level 0) or a missing one
+// (levels k and k + 2) between two groups leaves the pixels there without a coordinate.
+template <class PixelAt>
+void StripeDecoder::fillLine(ConstDirectionPlane d, StripePlane stripe, std::uint8_t axis,
+                             int length, PixelAt pixelAt) {
   const demux::UnitTable& units = units_[0];
-  const int steps = 2 * params_.maxGapPx;
-  const auto positionOf = [this](int x, int y) {
-    const Shift s = shift_[flat(x, y, width_)];
-    return PointQ8{x * 256 + s.x, y * 256 + s.y};
+  const auto indexAt = [&](int t) {
+    const PixelXY p = pixelAt(t);
+    return flat(p.x, p.y, width_);
   };
-  // The walk reaches at most maxGapPx + 1 pixels from its start along x and y.
-  const int reach = params_.maxGapPx + 1;
-  if constexpr (!kReference) {
-    integrateDecoded();
+  int count = 0;
+  for (int t = 0; t < length; ++t) {
+    if (code_[indexAt(t)] != 0) {
+      line_[static_cast<std::size_t>(count++)] = t;
+    }
   }
-  for (int y = 0; y < height_; ++y) {
-    StripeQ16* out = stripe.rowPtr(y);
-    const std::uint16_t* dirs = d.rowPtr(y);
-    // The integral image's rows just above and at the bottom of the square (nullptr: above the
-    // image, all zero).
-    const int above = y - reach - 1;
-    const int below = y + reach < height_ ? y + reach : height_ - 1;
-    const std::int32_t* top = above >= 0 ? &total_[flat(0, above, width_)] : nullptr;
-    const std::int32_t* bottom = &total_[flat(0, below, width_)];
-    for (int x = 0; x < width_; ++x) {
-      out[x] = kNoStripe;
-      if constexpr (!kReference) {
-        // Decoded boundary pixels within `reach` of (x, y) along x and y.
-        const int left = x - reach - 1;
-        const int right = x + reach < width_ ? x + reach : width_ - 1;
-        std::int32_t near = bottom[right] - (left >= 0 ? bottom[left] : 0);
-        if (top != nullptr) {
-          near -= top[right] - (left >= 0 ? top[left] : 0);
-        }
-        if (near == 0) {
-          continue;  // whatever the walk meets, it is no decoded boundary
-        }
-      }
-      const Unit u = unitOf(units, dirs[x]);
-      const PointQ8 here{x * 256, y * 256};
-      const auto behind = [&](int qx, int qy, std::int32_t) {
-        return along(positionOf(qx, qy), here, u);
-      };
-      const std::int32_t sx = -(u.x >> 7);
-      const std::int32_t sy = -(u.y >> 7);
-      Hit hit{};
-      if constexpr (kReference) {
-        hit = walk(code_, width_, height_, here, sx, sy, 0, steps, behind);
-      } else {
-        const std::size_t e = demux::UnitTable::entryOf(dirs[x]);
-        const std::span<const decode::BlockStep> blocks = fillBlocksOf(e).first(fillBlockCount_[e]);
-        hit = walkTable(code_, width_, height_, x, y, sx, sy, steps, blocks, behind);
-      }
-      const std::int32_t q = hit.at;
-      if (q == kNone) {
+  const auto at = [&](int j) { return line_[static_cast<std::size_t>(j)]; };
+  struct Group {
+    int first;  // pixels first … last of the line
+    int last;
+    std::int32_t level;
+    PointQ8 position;
+  };
+  // The group of line_[start … end].
+  const auto groupOf = [&](int start, int end) {
+    Group g{at(start), at(end), 0, {0, 0}};
+    PointQ8 sum{0, 0};
+    int decoded = 0;
+    for (int j = start; j <= end; ++j) {
+      const PixelXY p = pixelAt(at(j));
+      const std::size_t i = flat(p.x, p.y, width_);
+      const std::int32_t level = level_[i];
+      if (level == 0) {
         continue;
       }
-      const int qx = packedX(q);
-      const int qy = packedY(q);
-      const std::size_t qi = flat(qx, qy, width_);
-      const std::int32_t level = level_[qi];
-      const std::int32_t n = next_[qi];
-      if (level == 0 || n == kNone || level_[flat(packedX(n), packedY(n), width_)] != level + 1) {
+      g.level = g.level == 0 || g.level == level ? level : -1;
+      sum.x += p.x * 256 + shift_[i].x;
+      sum.y += p.y * 256 + shift_[i].y;
+      ++decoded;
+    }
+    if (g.level > 0) {
+      g.position = {sum.x / decoded, sum.y / decoded};
+    } else {
+      g.level = 0;
+    }
+    return g;
+  };
+  const std::int32_t maxBetween = (params_.maxGapPx + 1) * 256;
+  const auto fillBetween = [&](const Group& a, const Group& b) {
+    if (a.level == 0 || b.level == 0 || (a.level - b.level != 1 && b.level - a.level != 1)) {
+      return;
+    }
+    const Group& lower = a.level < b.level ? a : b;
+    const Group& upper = a.level < b.level ? b : a;
+    for (int t = a.first; t <= b.last; ++t) {
+      const PixelXY p = pixelAt(t);
+      StripeQ16& out = stripe.rowPtr(p.y)[p.x];
+      if (axis_[flat(p.x, p.y, width_)] != axis || out != kNoStripe) {
         continue;
       }
-      // The walk's distance to its hit is this one; the schedule does not compute it again.
-      const std::int32_t first = kReference ? along(positionOf(qx, qy), here, u) : hit.distance;
-      const std::int32_t between = first - along(positionOf(packedX(n), packedY(n)), here, u);
-      if (first >= between) {
-        continue;  // the pixel lies beyond the forward link
+      const Unit u = unitOf(units, d.rowPtr(p.y)[p.x]);
+      const std::int32_t first = along(lower.position, {p.x * 256, p.y * 256}, u);
+      const std::int32_t between = along(lower.position, upper.position, u);
+      if (first < 0 || first >= between || between > maxBetween) {
+        continue;
       }
-      out[x] = static_cast<StripeQ16>(std::int64_t{level} * kStripeOne +
-                                      std::int64_t{first} * kStripeOne / between);
+      out = static_cast<StripeQ16>(std::int64_t{lower.level} * kStripeOne +
+                                   std::int64_t{first} * kStripeOne / between);
       ++stats_.densePixels;
     }
+  };
+  Group previous{-1, -1, 0, {0, 0}};
+  int start = 0;
+  for (int j = 0; j < count; ++j) {
+    if (j + 1 < count && at(j + 1) == at(j) + 1 &&
+        code_[indexAt(at(j + 1))] == code_[indexAt(at(j))]) {
+      continue;  // the group goes on
+    }
+    const Group g = groupOf(start, j);
+    if (previous.first >= 0) {
+      fillBetween(previous, g);
+    }
+    previous = g;
+    start = j + 1;
   }
 }
 

@@ -28,10 +28,11 @@
 //      to a gap unlike the one on the other side) is dropped; each decoded boundary's position
 //      becomes the mean over its level's pixels within positionRadiusPx (noise along a curve is
 //      independent, the curve locally straight);
-//   4. dense coordinate: each pixel walks back along −axis to the nearest boundary; when that
-//      boundary (level k) is decoded and its forward link holds level k + 1 beyond the pixel,
-//      s = k + (distance from the first) / (distance between the two), both measured along the
-//      pixel's axis. Never across a missing, undecoded or non-consecutive boundary.
+//   4. dense coordinate: along rows and columns (each pixel takes the one nearer its own axis),
+//      between two consecutive boundaries of the line whose levels are k and k + 1, both decoded,
+//      s = k + (distance from the level-k boundary) / (distance between the two), both measured
+//      along the pixel's axis: a short interpolation per pixel, no search. Never across a
+//      missing, undecoded or non-consecutive boundary, nor a gap over maxGapPx + 1 pixels.
 namespace smx::algo {
 
 struct DecodeParams {
@@ -64,7 +65,6 @@ class UnitTable;
 }  // namespace demux
 namespace decode {
 struct Unit;
-struct BlockStep;
 }  // namespace decode
 
 class StripeDecoder {
@@ -107,10 +107,16 @@ class StripeDecoder {
   void joinCurves();
   template <bool kReference>
   void smoothPositions(ConstDirectionPlane d);
-  void integrateDecoded();
-  [[nodiscard]] std::span<decode::BlockStep> fillBlocksOf(std::size_t entry) const;
-  template <bool kReference>
   void fill(ConstDirectionPlane d, StripePlane stripe);
+  struct PixelXY {
+    int x;
+    int y;
+  };
+  static constexpr std::uint8_t kRowAxis = 1;
+  static constexpr std::uint8_t kColumnAxis = 2;
+  template <class PixelAt>
+  void fillLine(ConstDirectionPlane d, StripePlane stripe, std::uint8_t axis, int length,
+                PixelAt pixelAt);
 
   // The default positionRadiusPx, which the schedule's step 3b unrolls.
   static constexpr int kPositionRadius = 2;
@@ -130,10 +136,8 @@ class StripeDecoder {
   bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
   std::span<demux::UnitTable> units_;  // one table
-  // The fill's walks per unit-table direction: 2 · maxGapPx + 1 block slots each (fillBlocksOf),
-  // and how many of them the walk uses.
-  std::span<decode::BlockStep> fillBlocks_;
-  std::span<std::uint8_t> fillBlockCount_;
+  std::span<std::int32_t> line_;       // the fill's boundary pixels of one row or column
+  std::span<std::uint8_t> axis_;       // the fill's kind of line per pixel (kRowAxis, kColumnAxis)
   std::span<std::uint8_t> code_;       // Boundary::transition (0: none)
   std::span<Shift> shift_;             // where the boundary lies
   std::span<std::int32_t> next_;       // linked boundary ahead: y << 16 | x, or −1
