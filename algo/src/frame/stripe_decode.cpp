@@ -13,6 +13,7 @@
 //              0 ≤ dFirst < dBetween, so s stays within [level, level + 1) · 2^16.
 #include "smx/algo/stripe_decode.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -120,6 +121,7 @@ Result<void> StripeDecoder::carve(Carver& carver) {
   step(carveSpan(carver, units_, 1));
   step(carveSpan(carver, line_, static_cast<std::size_t>(width_ > height_ ? width_ : height_)));
   step(carveSpan(carver, axis_, pixels));
+  step(carveSpan(carver, boundaries_, pixels));
   step(carveSpan(carver, code_, pixels));
   step(carveSpan(carver, shift_, pixels));
   step(carveSpan(carver, next_, pixels));
@@ -201,7 +203,7 @@ void StripeDecoder::runSteps(ConstDirectionPlane d, StripePlane stripe) {
 }
 
 // Each boundary's class and sub-pixel shift in flat planes (the walks below read them many
-// times).
+// times), and the list of boundary pixels in ascending order.
 void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
   const demux::UnitTable& units = units_[0];
   for (int y = 0; y < height_; ++y) {
@@ -215,8 +217,28 @@ void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
         const Unit u = unitOf(units, dirs[x]);
         shift_[i] = {static_cast<std::int16_t>((row[x].offset * u.x + 8192) >> 14),
                      static_cast<std::int16_t>((row[x].offset * u.y + 8192) >> 14)};
-        ++stats_.boundaryPixels;
+        boundaries_[static_cast<std::size_t>(stats_.boundaryPixels++)] =
+            static_cast<std::int32_t>(i);
       }
+    }
+  }
+}
+
+// f(i) for every boundary pixel i, in ascending order: the reference looks at every pixel, the
+// schedule reads the list prepare() made. Steps 1–3 read and write their per-pixel planes only
+// at boundary pixels.
+template <bool kReference, class F>
+void StripeDecoder::eachBoundary(F f) const {
+  if constexpr (kReference) {
+    for (std::size_t i = 0; i < code_.size(); ++i) {
+      if (code_[i] != 0) {
+        f(i);
+      }
+    }
+  } else {
+    for (const std::int32_t i :
+         boundaries_.first(static_cast<std::size_t>(stats_.boundaryPixels))) {
+      f(static_cast<std::size_t>(i));
     }
   }
 }
@@ -228,38 +250,32 @@ template <bool kReference>
 void StripeDecoder::link(ConstDirectionPlane d) {
   const demux::UnitTable& units = units_[0];
   const int steps = 2 * params_.maxGapPx;
-  for (int y = 0; y < height_; ++y) {
-    const std::uint16_t* dirs = d.rowPtr(y);
-    for (int x = 0; x < width_; ++x) {
-      const std::size_t i = flat(x, y, width_);
-      next_[i] = kNone;
-      prev_[i] = kNone;
-      if (code_[i] == 0) {
-        continue;
-      }
-      const Unit u = unitOf(units, dirs[x]);
-      const PointQ8 p{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
-      for (int sign = -1; sign <= 1; sign += 2) {
-        const auto distance = [&](int qx, int qy, std::int32_t q) -> std::int32_t {
-          const auto qi = static_cast<std::size_t>(q);
-          if (code_[qi] == code_[i]) {
-            return -1;
-          }
-          const PointQ8 qp{qx * 256 + shift_[qi].x, qy * 256 + shift_[qi].y};
-          const std::int32_t dist = sign * along(p, qp, u);
-          return dist >= params_.minSeparationQ8 ? dist : -1;
-        };
-        const std::int32_t sx = sign * (u.x >> 7);
-        const std::int32_t sy = sign * (u.y >> 7);
-        const Hit hit =
-            kReference ? walk(code_, width_, height_, p, sx, sy, 1, steps, distance)
-                       : walkSkippingEmpty(code_, width_, height_, p, sx, sy, 1, steps, distance);
-        (sign > 0 ? next_ : prev_)[i] = hit.at;
-        // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
-        (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
-      }
+  const auto w = static_cast<std::size_t>(width_);
+  eachBoundary<kReference>([&](std::size_t i) {
+    const int x = static_cast<int>(i % w);
+    const int y = static_cast<int>(i / w);
+    const Unit u = unitOf(units, d.rowPtr(y)[x]);
+    const PointQ8 p{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const auto distance = [&](int qx, int qy, std::int32_t q) -> std::int32_t {
+        const auto qi = static_cast<std::size_t>(q);
+        if (code_[qi] == code_[i]) {
+          return -1;
+        }
+        const PointQ8 qp{qx * 256 + shift_[qi].x, qy * 256 + shift_[qi].y};
+        const std::int32_t dist = sign * along(p, qp, u);
+        return dist >= params_.minSeparationQ8 ? dist : -1;
+      };
+      const std::int32_t sx = sign * (u.x >> 7);
+      const std::int32_t sy = sign * (u.y >> 7);
+      const Hit hit =
+          kReference ? walk(code_, width_, height_, p, sx, sy, 1, steps, distance)
+                     : walkSkippingEmpty(code_, width_, height_, p, sx, sy, 1, steps, distance);
+      (sign > 0 ? next_ : prev_)[i] = hit.at;
+      // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
+      (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
     }
-  }
+  });
 }
 
 // Step 2. The chain around each pixel (index kChainEachWay is the pixel itself), then every
@@ -288,14 +304,11 @@ void StripeDecoder::vote() {
   // The schedule decides each pixel's two steps once, not once per chain through it: bit 0 the
   // step behind, bit 1 the step ahead, in candidate_ (free until step 3 sets it).
   if constexpr (!kReference) {
-    for (std::size_t i = 0; i < code_.size(); ++i) {
-      if (code_[i] == 0) {
-        continue;
-      }
+    eachBoundary<false>([&](std::size_t i) {
       const bool back = prev_[i] != kNone && stepsBack(i, indexOf(prev_[i]));
       const bool ahead = next_[i] != kNone && stepsAhead(i, indexOf(next_[i]));
       candidate_[i] = static_cast<std::int16_t>((back ? 1 : 0) | (ahead ? 2 : 0));
-    }
+    });
   }
   const auto chains = [&](std::size_t cur, std::size_t n, int bit) {
     if constexpr (kReference) {
@@ -304,12 +317,9 @@ void StripeDecoder::vote() {
       return (candidate_[cur] & bit) != 0;
     }
   };
-  for (std::size_t i = 0; i < code_.size(); ++i) {
+  eachBoundary<kReference>([&](std::size_t i) {
     own_[i] = 0;
     votes_[i] = 0;
-    if (code_[i] == 0) {
-      continue;
-    }
     std::array<stripe::Transition, 2 * kChainEachWay + 1> chain{};
     chain[kChainEachWay] = kindAt(i);
     int lo = kChainEachWay;
@@ -366,7 +376,7 @@ void StripeDecoder::vote() {
       votes_[i] = static_cast<std::int16_t>(bestVotes);
       ++stats_.votedPixels;
     }
-  }
+  });
 }
 
 // Step 3. Union-find over touching boundary pixels of one class (parent = smaller index, path
@@ -391,52 +401,47 @@ void StripeDecoder::joinCurves() {
       parent_[static_cast<std::size_t>(ra)] = rc;
     }
   };
-  for (std::size_t i = 0; i < code_.size(); ++i) {
-    parent_[i] = code_[i] != 0 ? static_cast<std::int32_t>(i) : kNone;
+  eachBoundary<kReference>([&](std::size_t i) {
+    parent_[i] = static_cast<std::int32_t>(i);
     weight_[i] = 0;
     total_[i] = 0;
     candidate_[i] = 0;
-  }
+  });
   if (params_.curves) {
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        const std::int32_t i = y * width_ + x;
-        const std::uint8_t t = code_[flat(x, y, width_)];
-        if (t == 0) {
-          continue;
-        }
-        if (x + 1 < width_ && code_[flat(x + 1, y, width_)] == t) {
-          unite(i, i + 1);
-        }
-        if (y + 1 == height_) {
-          continue;
-        }
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (x + dx >= 0 && x + dx < width_ && code_[flat(x + dx, y + 1, width_)] == t) {
-            unite(i, i + width_ + dx);
-          }
+    const auto w = static_cast<std::size_t>(width_);
+    eachBoundary<kReference>([&](std::size_t at) {
+      const int x = static_cast<int>(at % w);
+      const int y = static_cast<int>(at / w);
+      const auto i = static_cast<std::int32_t>(at);
+      const std::uint8_t t = code_[at];
+      if (x + 1 < width_ && code_[flat(x + 1, y, width_)] == t) {
+        unite(i, i + 1);
+      }
+      if (y + 1 == height_) {
+        return;
+      }
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (x + dx >= 0 && x + dx < width_ && code_[flat(x + dx, y + 1, width_)] == t) {
+          unite(i, i + width_ + dx);
         }
       }
-    }
+    });
   }
   // The schedule flattens the forest once: a parent has the smaller index, so in ascending
   // order each parent already points at its root. Every later look-up is then one load.
   if constexpr (!kReference) {
-    for (std::size_t i = 0; i < code_.size(); ++i) {
-      if (code_[i] != 0) {
-        parent_[i] = parent_[static_cast<std::size_t>(parent_[i])];
-      }
-    }
+    eachBoundary<false>(
+        [&](std::size_t i) { parent_[i] = parent_[static_cast<std::size_t>(parent_[i])]; });
   }
   const auto rootOf = [&](std::size_t i) {
     return static_cast<std::size_t>(kReference ? find(static_cast<std::int32_t>(i)) : parent_[i]);
   };
   // Majority candidate per root, then its support among all votes of the curve.
   for (int pass = 0; pass < 2; ++pass) {
-    for (std::size_t i = 0; i < code_.size(); ++i) {
+    eachBoundary<kReference>([&](std::size_t i) {
       const std::int32_t v = votes_[i];
       if (v == 0) {
-        continue;
+        return;
       }
       const auto r = rootOf(i);
       if (pass == 0) {
@@ -452,18 +457,13 @@ void StripeDecoder::joinCurves() {
         total_[r] += v;
         weight_[r] += candidate_[r] == own_[i] ? v : 0;
       }
-    }
+    });
     if (pass == 0) {
-      for (auto& w : weight_) {
-        w = 0;
-      }
+      eachBoundary<kReference>([&](std::size_t i) { weight_[i] = 0; });
     }
   }
-  for (std::size_t i = 0; i < code_.size(); ++i) {
-    level_[i] = 0;
-    if (code_[i] == 0) {
-      continue;
-    }
+  std::fill(level_.begin(), level_.end(), std::int16_t{0});
+  eachBoundary<kReference>([&](std::size_t i) {
     const auto r = rootOf(i);
     const bool majority = 2 * weight_[r] > total_[r] && weight_[r] >= params_.minCurveVotes;
     if (r == i && majority) {
@@ -472,23 +472,23 @@ void StripeDecoder::joinCurves() {
     if (majority && (own_[i] == candidate_[r] || votes_[i] < 2)) {
       level_[i] = candidate_[r];
     }
-  }
+  });
   // The next layer: a curve's links should lead to decoded curves one level on either side, at
   // about the same distance on both (a skipped or mislocated boundary makes one gap much longer
   // than the other). Per root, the links that fit (weight_) and the links to decoded pixels that
   // do not (total_); a curve with too large a share of misfits is dropped.
-  for (std::size_t i = 0; i < code_.size(); ++i) {
+  eachBoundary<kReference>([&](std::size_t i) {
     weight_[i] = 0;
     total_[i] = 0;
-  }
+  });
   const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
     return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
   };
   const std::int32_t ratio = params_.maxGapRatioPct;
-  for (std::size_t i = 0; i < code_.size(); ++i) {
+  eachBoundary<kReference>([&](std::size_t i) {
     const std::int32_t level = level_[i];
     if (level == 0) {
-      continue;
+      return;
     }
     const auto r = rootOf(i);
     const std::int32_t ahead = linkedLevel(next_[i]);
@@ -503,10 +503,10 @@ void StripeDecoder::joinCurves() {
     }
     weight_[r] += (aheadFits ? 1 : 0) + (behindFits ? 1 : 0);
     total_[r] += (ahead != 0 && !aheadFits ? 1 : 0) + (behind != 0 && !behindFits ? 1 : 0);
-  }
-  for (std::size_t i = 0; i < code_.size(); ++i) {
+  });
+  eachBoundary<kReference>([&](std::size_t i) {
     if (level_[i] == 0) {
-      continue;
+      return;
     }
     const auto r = rootOf(i);
     if (std::int64_t{100} * total_[r] >
@@ -515,7 +515,7 @@ void StripeDecoder::joinCurves() {
     } else {
       ++stats_.decodedPixels;
     }
-  }
+  });
 }
 
 // The schedule's step 3b for a pixel whose window lies inside the image, at the default radius:
@@ -547,49 +547,44 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
     return;
   }
   const demux::UnitTable& units = units_[0];
-  for (int y = 0; y < height_; ++y) {
-    const std::uint16_t* dirs = d.rowPtr(y);
-    for (int x = 0; x < width_; ++x) {
-      const std::size_t i = flat(x, y, width_);
-      const std::int16_t level = level_[i];
-      if (level == 0) {
-        continue;
-      }
-      const Unit u = unitOf(units, dirs[x]);
-      const PointQ8 centre{x * 256, y * 256};
-      std::int32_t sum = 0;
-      std::int32_t count = 0;
-      if (!kReference && r == kPositionRadius && x >= r && y >= r && x + r < width_ &&
-          y + r < height_) {
-        sumLevelAround<kPositionRadius>(i, u, sum, count);
-        weight_[i] = (sum >= 0 ? sum + count / 2 : sum - count / 2) / count;
-        continue;
-      }
-      for (int qy = y > r ? y - r : 0; qy <= y + r && qy < height_; ++qy) {
-        for (int qx = x > r ? x - r : 0; qx <= x + r && qx < width_; ++qx) {
-          const std::size_t q = flat(qx, qy, width_);
-          if (level_[q] == level) {
-            sum += along(centre, {qx * 256 + shift_[q].x, qy * 256 + shift_[q].y}, u);
-            ++count;
-          }
+  const auto w = static_cast<std::size_t>(width_);
+  eachBoundary<kReference>([&](std::size_t i) {
+    const int x = static_cast<int>(i % w);
+    const int y = static_cast<int>(i / w);
+    const std::int16_t level = level_[i];
+    if (level == 0) {
+      return;
+    }
+    const Unit u = unitOf(units, d.rowPtr(y)[x]);
+    const PointQ8 centre{x * 256, y * 256};
+    std::int32_t sum = 0;
+    std::int32_t count = 0;
+    if (!kReference && r == kPositionRadius && x >= r && y >= r && x + r < width_ &&
+        y + r < height_) {
+      sumLevelAround<kPositionRadius>(i, u, sum, count);
+      weight_[i] = (sum >= 0 ? sum + count / 2 : sum - count / 2) / count;
+      return;
+    }
+    for (int qy = y > r ? y - r : 0; qy <= y + r && qy < height_; ++qy) {
+      for (int qx = x > r ? x - r : 0; qx <= x + r && qx < width_; ++qx) {
+        const std::size_t q = flat(qx, qy, width_);
+        if (level_[q] == level) {
+          sum += along(centre, {qx * 256 + shift_[q].x, qy * 256 + shift_[q].y}, u);
+          ++count;
         }
       }
-      // count ≥ 1 (the pixel itself counts); round half away from zero.
-      weight_[i] = count > 0 ? (sum >= 0 ? sum + count / 2 : sum - count / 2) / count : 0;
     }
-  }
-  for (int y = 0; y < height_; ++y) {
-    const std::uint16_t* dirs = d.rowPtr(y);
-    for (int x = 0; x < width_; ++x) {
-      const std::size_t i = flat(x, y, width_);
-      if (level_[i] == 0) {
-        continue;
-      }
-      const Unit u = unitOf(units, dirs[x]);
-      shift_[i] = {static_cast<std::int16_t>((weight_[i] * u.x + 8192) >> 14),
-                   static_cast<std::int16_t>((weight_[i] * u.y + 8192) >> 14)};
+    // count ≥ 1 (the pixel itself counts); round half away from zero.
+    weight_[i] = count > 0 ? (sum >= 0 ? sum + count / 2 : sum - count / 2) / count : 0;
+  });
+  eachBoundary<kReference>([&](std::size_t i) {
+    if (level_[i] == 0) {
+      return;
     }
-  }
+    const Unit u = unitOf(units, d.rowPtr(static_cast<int>(i / w))[i % w]);
+    shift_[i] = {static_cast<std::int16_t>((weight_[i] * u.x + 8192) >> 14),
+                 static_cast<std::int16_t>((weight_[i] * u.y + 8192) >> 14)};
+  });
 }
 
 // Step 4. Every row, then every column, as a scan line; each pixel takes the kind of line nearer

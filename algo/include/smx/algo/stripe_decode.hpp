@@ -99,6 +99,8 @@ class StripeDecoder {
   template <bool kReference>
   void runSteps(ConstDirectionPlane d, StripePlane stripe);
   void prepare(ConstBoundaryPlane b, ConstDirectionPlane d);
+  template <bool kReference, class F>
+  void eachBoundary(F f) const;
   template <bool kReference>
   void link(ConstDirectionPlane d);
   template <bool kReference>
@@ -135,22 +137,23 @@ class StripeDecoder {
   DecodeStats stats_;
   bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
-  std::span<demux::UnitTable> units_;  // one table
-  std::span<std::int32_t> line_;       // the fill's boundary pixels of one row or column
-  std::span<std::uint8_t> axis_;       // the fill's kind of line per pixel (kRowAxis, kColumnAxis)
-  std::span<std::uint8_t> code_;       // Boundary::transition (0: none)
-  std::span<Shift> shift_;             // where the boundary lies
-  std::span<std::int32_t> next_;       // linked boundary ahead: y << 16 | x, or −1
-  std::span<std::int32_t> prev_;       // behind
-  std::span<std::int16_t> gapNext_;    // distance to the link ahead along the axis, Q8 px
-  std::span<std::int16_t> gapPrev_;    // behind
-  std::span<std::int32_t> parent_;     // union-find over boundary pixels
-  std::span<std::int32_t> weight_;     // per curve root: Boyer–Moore count, then support
-  std::span<std::int32_t> total_;      // per curve root: all votes
-  std::span<std::int16_t> candidate_;  // per curve root: Boyer–Moore candidate level
-  std::span<std::int16_t> votes_;      // windows agreeing on the pixel's own level
-  std::span<std::int16_t> own_;        // the pixel's own level (0 = none)
-  std::span<std::int16_t> level_;      // final level
+  std::span<demux::UnitTable> units_;   // one table
+  std::span<std::int32_t> line_;        // the fill's boundary pixels of one row or column
+  std::span<std::uint8_t> axis_;        // the fill's kind of line per pixel (kRowAxis, kColumnAxis)
+  std::span<std::int32_t> boundaries_;  // boundary pixels' indices, ascending (stats_ counts)
+  std::span<std::uint8_t> code_;        // Boundary::transition (0: none)
+  std::span<Shift> shift_;              // where the boundary lies
+  std::span<std::int32_t> next_;        // linked boundary ahead: y << 16 | x, or −1
+  std::span<std::int32_t> prev_;        // behind
+  std::span<std::int16_t> gapNext_;     // distance to the link ahead along the axis, Q8 px
+  std::span<std::int16_t> gapPrev_;     // behind
+  std::span<std::int32_t> parent_;      // union-find over boundary pixels
+  std::span<std::int32_t> weight_;      // per curve root: Boyer–Moore count, then support
+  std::span<std::int32_t> total_;       // per curve root: all votes
+  std::span<std::int16_t> candidate_;   // per curve root: Boyer–Moore candidate level
+  std::span<std::int16_t> votes_;       // windows agreeing on the pixel's own level
+  std::span<std::int16_t> own_;         // the pixel's own level (0 = none)
+  std::span<std::int16_t> level_;       // final level
 };
 
 }  // namespace smx::algo
