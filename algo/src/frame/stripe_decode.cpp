@@ -8,7 +8,7 @@
 //              the shift offset·u is rounded half up to Q8 once per frame (|shift| ≤ 128).
 //   Distances  along an axis: dot(ΔQ8, uQ14) >> 14 in int64, so any Δ within the image is exact
 //              before the shift; the shift rounds towards −∞ (≤ 1/256 px).
-//   Lines      links and the dense coordinate run along rows and columns (prepare()).
+//   Walks      half-pixel steps: (u >> 7) in Q8, looking at the 2×2 pixels around each sample.
 //   Coordinate s = level · 2^16 + (dFirst · 2^16) / dBetween, int64, truncated (< 2^-16 stripe);
 //              0 ≤ dFirst < dBetween, so s stays within [level, level + 1) · 2^16.
 #include "smx/algo/stripe_decode.hpp"
@@ -26,12 +26,15 @@ namespace smx::algo {
 
 using decode::along;
 using decode::flat;
+using decode::Hit;
 using decode::kNone;
 using decode::packedX;
 using decode::packedY;
 using decode::PointQ8;
 using decode::Unit;
 using decode::unitOf;
+using decode::walk;
+using decode::walkSkippingEmpty;
 
 namespace {
 
@@ -117,8 +120,6 @@ Result<void> StripeDecoder::carve(Carver& carver) {
   };
   step(carveSpan(carver, units_, 1));
   step(carveSpan(carver, line_, static_cast<std::size_t>(width_ > height_ ? width_ : height_)));
-  step(carveSpan(carver, groupStart_,
-                 static_cast<std::size_t>(width_ > height_ ? width_ : height_) + 1));
   step(carveSpan(carver, axis_, pixels));
   step(carveSpan(carver, boundaries_, pixels));
   step(carveSpan(carver, code_, pixels));
@@ -194,31 +195,23 @@ Result<void> StripeDecoder::run(ConstBoundaryPlane boundaries, ConstDirectionPla
 
 template <bool kReference>
 void StripeDecoder::runSteps(ConstDirectionPlane d, StripePlane stripe) {
-  link(d);
+  link<kReference>(d);
   vote<kReference>();
   joinCurves<kReference>();
   smoothPositions<kReference>(d);
   fill(d, stripe);
 }
 
-// Each boundary's class and sub-pixel shift in flat planes, the list of boundary pixels in
-// ascending order, and each pixel's kind of scan line: a row when its axis lies within 45° of x,
-// a column otherwise. A boundary curve crosses the lines of its pixels' kind with a pixel on each
-// (an 8-connected curve within 45° of the lines' normal has a pixel on every line it spans).
+// Each boundary's class and sub-pixel shift in flat planes (the walks below read them many
+// times), and the list of boundary pixels in ascending order.
 void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
   const demux::UnitTable& units = units_[0];
-  rowPixels_ = 0;
   for (int y = 0; y < height_; ++y) {
     const Boundary* row = b.rowPtr(y);
     const std::uint16_t* dirs = d.rowPtr(y);
     const auto base = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = base + static_cast<std::size_t>(x);
-      // Within 45° of ±x: the angle (2^16 a turn) plus an eighth turn, modulo a half turn, lies
-      // in the first quarter turn.
-      const bool rowAxis = ((dirs[x] + 8192U) & 32767U) < 16384U;
-      axis_[i] = rowAxis ? kRowAxis : kColumnAxis;
-      rowPixels_ += rowAxis ? 1 : 0;
       code_[i] = row[x].transition;
       if (row[x].present()) {
         const Unit u = unitOf(units, dirs[x]);
@@ -250,64 +243,39 @@ void StripeDecoder::eachBoundary(F f) const {
   }
 }
 
-// Step 1. Along the scan line of the boundary pixel's kind (prepare()), ahead (+axis) and
-// behind (−axis): the nearest pixel of the first group of another class at least minSeparation
-// along the axis is the link, none beyond maxGapPx + 1 px (groups of the same class met first
-// are the same curve seen on a staircase).
+// Step 1. From the boundary's sub-pixel position, half-pixel steps along ±axis; the first pixel
+// holding a boundary of another class at least minSeparation along the axis is the link
+// (boundaries of the same class met first are the same curve seen on a staircase).
+template <bool kReference>
 void StripeDecoder::link(ConstDirectionPlane d) {
-  eachLine(
-      [&](std::uint8_t axis, int length, auto pixelAt) { linkLine(d, axis, length, pixelAt); });
-}
-
-template <class PixelAt>
-void StripeDecoder::linkLine(ConstDirectionPlane d, std::uint8_t axis, int length,
-                             PixelAt pixelAt) {
   const demux::UnitTable& units = units_[0];
-  const int groups = lineGroups(length, pixelAt);
-  const std::int32_t maxDistance = (params_.maxGapPx + 1) * 256;
-  const auto positionOf = [&](PixelXY p, std::size_t i) {
-    return PointQ8{p.x * 256 + shift_[i].x, p.y * 256 + shift_[i].y};
-  };
-  for (int g = 0; g < groups; ++g) {
-    for (int j = groupStart_[static_cast<std::size_t>(g)];
-         j < groupStart_[static_cast<std::size_t>(g + 1)]; ++j) {
-      const PixelXY p = pixelAt(line_[static_cast<std::size_t>(j)]);
-      const std::size_t i = flat(p.x, p.y, width_);
-      if (axis_[i] != axis) {
-        continue;
-      }
-      const Unit u = unitOf(units, d.rowPtr(p.y)[p.x]);
-      const PointQ8 from = positionOf(p, i);
-      const int forward = (axis == kRowAxis ? u.x : u.y) > 0 ? 1 : -1;
-      for (int sign = -1; sign <= 1; sign += 2) {
-        const int step = sign * forward;
-        std::int32_t at = kNone;
-        std::int32_t gap = 0;
-        for (int h = g + step; h >= 0 && h < groups; h += step) {
-          const std::int32_t entry = step > 0 ? groupStart_[static_cast<std::size_t>(h)]
-                                              : groupStart_[static_cast<std::size_t>(h + 1)] - 1;
-          const PixelXY q = pixelAt(line_[static_cast<std::size_t>(entry)]);
-          const std::size_t qi = flat(q.x, q.y, width_);
-          if (code_[qi] == code_[i]) {
-            continue;
-          }
-          const std::int32_t distance = sign * along(from, positionOf(q, qi), u);
-          if (distance > maxDistance) {
-            break;
-          }
-          if (distance < params_.minSeparationQ8) {
-            continue;
-          }
-          at = decode::pack(q.x, q.y);
-          gap = distance;
-          break;
+  const int steps = 2 * params_.maxGapPx;
+  const auto w = static_cast<std::size_t>(width_);
+  eachBoundary<kReference>([&](std::size_t i) {
+    const int x = static_cast<int>(i % w);
+    const int y = static_cast<int>(i / w);
+    const Unit u = unitOf(units, d.rowPtr(y)[x]);
+    const PointQ8 p{x * 256 + shift_[i].x, y * 256 + shift_[i].y};
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const auto distance = [&](int qx, int qy, std::int32_t q) -> std::int32_t {
+        const auto qi = static_cast<std::size_t>(q);
+        if (code_[qi] == code_[i]) {
+          return -1;
         }
-        (sign > 0 ? next_ : prev_)[i] = at;
-        // ≤ (maxGapPx + 1) px ≤ 65 · 256 in Q8.
-        (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(gap);
-      }
+        const PointQ8 qp{qx * 256 + shift_[qi].x, qy * 256 + shift_[qi].y};
+        const std::int32_t dist = sign * along(p, qp, u);
+        return dist >= params_.minSeparationQ8 ? dist : -1;
+      };
+      const std::int32_t sx = sign * (u.x >> 7);
+      const std::int32_t sy = sign * (u.y >> 7);
+      const Hit hit =
+          kReference ? walk(code_, width_, height_, p, sx, sy, 1, steps, distance)
+                     : walkSkippingEmpty(code_, width_, height_, p, sx, sy, 1, steps, distance);
+      (sign > 0 ? next_ : prev_)[i] = hit.at;
+      // ≤ (maxGapPx + 2) px ≤ 66 · 256 in Q8.
+      (sign > 0 ? gapNext_ : gapPrev_)[i] = static_cast<std::int16_t>(hit.distance);
     }
-  }
+  });
 }
 
 // Step 2. The chain around each pixel (index kChainEachWay is the pixel itself), then every
@@ -619,61 +587,37 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
   });
 }
 
-// Step 4. Each pixel along the scan line of its kind (prepare()). A curve missing its pixel on a
-// line leaves that line's pixels beside it without a coordinate: filling them from the
-// neighbouring line gives more coordinates but more wrong ones (docs/decode.md).
+// Step 4. Every row, then every column, as a scan line; each pixel takes the kind of line nearer
+// its own axis (a row when the axis lies within 45° of x), which a boundary curve crosses with a
+// pixel on it (an 8-connected curve within 45° of the line's normal has a pixel on every line it
+// spans). A curve missing its pixel on a line leaves that line's pixels beside it without a
+// coordinate: filling them from the neighbouring line (as the walks of step 1 look at 2 × 2 blocks)
+// gives more coordinates but more wrong ones (docs/decode.md).
 void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
+  int rowPixels = 0;
   for (int y = 0; y < height_; ++y) {
     StripeQ16* out = stripe.rowPtr(y);
+    const std::uint16_t* dirs = d.rowPtr(y);
+    std::uint8_t* axis = &axis_[flat(0, y, width_)];
     for (int x = 0; x < width_; ++x) {
       out[x] = kNoStripe;
+      // Within 45° of ±x: the angle (2^16 a turn) plus an eighth turn, modulo a half turn, lies
+      // in the first quarter turn.
+      const bool row = ((dirs[x] + 8192U) & 32767U) < 16384U;
+      axis[x] = row ? kRowAxis : kColumnAxis;
+      rowPixels += row ? 1 : 0;
     }
   }
-  eachLine([&](std::uint8_t axis, int length, auto pixelAt) {
-    fillLine(d, stripe, axis, length, pixelAt);
-  });
-}
-
-// f(axis, length, pixelAt) for every row, then every column, where some pixel takes that kind.
-template <class F>
-void StripeDecoder::eachLine(F f) {
-  if (rowPixels_ > 0) {
+  if (rowPixels > 0) {
     for (int y = 0; y < height_; ++y) {
-      f(kRowAxis, width_, [y](int t) { return PixelXY{t, y}; });
+      fillLine(d, stripe, kRowAxis, width_, [y](int t) { return PixelXY{t, y}; });
     }
   }
-  if (rowPixels_ < width_ * height_) {
+  if (rowPixels < width_ * height_) {
     for (int x = 0; x < width_; ++x) {
-      f(kColumnAxis, height_, [x](int t) { return PixelXY{x, t}; });
+      fillLine(d, stripe, kColumnAxis, height_, [x](int t) { return PixelXY{x, t}; });
     }
   }
-}
-
-// The boundary pixels of one line (pixelAt(0 … length − 1)) in order into line_, and their
-// groups, runs of adjacent pixels of one class (one boundary crossing the line): group g is
-// line_[groupStart_[g] … groupStart_[g + 1]). Returns the number of groups.
-template <class PixelAt>
-int StripeDecoder::lineGroups(int length, PixelAt pixelAt) {
-  const auto indexAt = [&](int t) {
-    const PixelXY p = pixelAt(t);
-    return flat(p.x, p.y, width_);
-  };
-  int count = 0;
-  int groups = 0;
-  std::uint8_t last = 0;
-  for (int t = 0; t < length; ++t) {
-    const std::uint8_t code = code_[indexAt(t)];
-    if (code == 0) {
-      continue;
-    }
-    if (count == 0 || line_[static_cast<std::size_t>(count - 1)] != t - 1 || code != last) {
-      groupStart_[static_cast<std::size_t>(groups++)] = count;
-    }
-    line_[static_cast<std::size_t>(count++)] = t;
-    last = code;
-  }
-  groupStart_[static_cast<std::size_t>(groups)] = count;
-  return groups;
 }
 
 // One scan line of step 4: `length` pixels, pixel t at pixelAt(t). The line's boundary pixels,
@@ -690,40 +634,46 @@ template <class PixelAt>
 void StripeDecoder::fillLine(ConstDirectionPlane d, StripePlane stripe, std::uint8_t axis,
                              int length, PixelAt pixelAt) {
   const demux::UnitTable& units = units_[0];
-  const int groups = lineGroups(length, pixelAt);
+  const auto indexAt = [&](int t) {
+    const PixelXY p = pixelAt(t);
+    return flat(p.x, p.y, width_);
+  };
+  int count = 0;
+  for (int t = 0; t < length; ++t) {
+    if (code_[indexAt(t)] != 0) {
+      line_[static_cast<std::size_t>(count++)] = t;
+    }
+  }
+  const auto at = [&](int j) { return line_[static_cast<std::size_t>(j)]; };
   struct Group {
     int first;  // pixels first … last of the line
     int last;
     std::int32_t level;
     PointQ8 position;
   };
-  const auto groupOf = [&](int g) {
-    const std::int32_t start = groupStart_[static_cast<std::size_t>(g)];
-    const std::int32_t end = groupStart_[static_cast<std::size_t>(g + 1)];
-    Group group{line_[static_cast<std::size_t>(start)],
-                line_[static_cast<std::size_t>(end - 1)],
-                0,
-                {0, 0}};
+  // The group of line_[start … end].
+  const auto groupOf = [&](int start, int end) {
+    Group g{at(start), at(end), 0, {0, 0}};
     PointQ8 sum{0, 0};
     int decoded = 0;
-    for (std::int32_t j = start; j < end; ++j) {
-      const PixelXY p = pixelAt(line_[static_cast<std::size_t>(j)]);
+    for (int j = start; j <= end; ++j) {
+      const PixelXY p = pixelAt(at(j));
       const std::size_t i = flat(p.x, p.y, width_);
       const std::int32_t level = level_[i];
       if (level == 0) {
         continue;
       }
-      group.level = group.level == 0 || group.level == level ? level : -1;
+      g.level = g.level == 0 || g.level == level ? level : -1;
       sum.x += p.x * 256 + shift_[i].x;
       sum.y += p.y * 256 + shift_[i].y;
       ++decoded;
     }
-    if (group.level > 0) {
-      group.position = {sum.x / decoded, sum.y / decoded};
+    if (g.level > 0) {
+      g.position = {sum.x / decoded, sum.y / decoded};
     } else {
-      group.level = 0;
+      g.level = 0;
     }
-    return group;
+    return g;
   };
   const std::int32_t maxBetween = (params_.maxGapPx + 1) * 256;
   const auto fillBetween = [&](const Group& a, const Group& b) {
@@ -749,14 +699,19 @@ void StripeDecoder::fillLine(ConstDirectionPlane d, StripePlane stripe, std::uin
       ++stats_.densePixels;
     }
   };
-  if (groups == 0) {
-    return;
-  }
-  Group previous = groupOf(0);
-  for (int g = 1; g < groups; ++g) {
-    const Group next = groupOf(g);
-    fillBetween(previous, next);
-    previous = next;
+  Group previous{-1, -1, 0, {0, 0}};
+  int start = 0;
+  for (int j = 0; j < count; ++j) {
+    if (j + 1 < count && at(j + 1) == at(j) + 1 &&
+        code_[indexAt(at(j + 1))] == code_[indexAt(at(j))]) {
+      continue;  // the group goes on
+    }
+    const Group g = groupOf(start, j);
+    if (previous.first >= 0) {
+      fillBetween(previous, g);
+    }
+    previous = g;
+    start = j + 1;
   }
 }
 

@@ -15,9 +15,7 @@
 //
 // Per frame, integer-only and allocation-free (src/frame/stripe_decode.cpp):
 //   1. links: from each boundary pixel, the first boundary of another class met along +axis and
-//      along −axis at least minSeparation away and at most maxGapPx + 1 px, on its scan line: its
-//      row when its axis lies within 45° of x, else its column (a boundary curve has a pixel on
-//      every such line it crosses);
+//      along −axis (half-pixel steps from its sub-pixel position, at most maxGapPx);
 //   2. votes: the chain of linked boundaries around each pixel, read along +axis, as long as the
 //      colours chain (to-colour of one = from-colour of the next), up to 5 each way; every window
 //      of 6 transitions holding the pixel decodes to a level (stripe::decodeWindow); the pixel
@@ -30,15 +28,15 @@
 //      to a gap unlike the one on the other side) is dropped; each decoded boundary's position
 //      becomes the mean over its level's pixels within positionRadiusPx (noise along a curve is
 //      independent, the curve locally straight);
-//   4. dense coordinate: along each pixel's scan line, between two consecutive boundaries of the
-//   line whose levels are k and k + 1, both decoded,
+//   4. dense coordinate: along rows and columns (each pixel takes the one nearer its own axis),
+//      between two consecutive boundaries of the line whose levels are k and k + 1, both decoded,
 //      s = k + (distance from the level-k boundary) / (distance between the two), both measured
 //      along the pixel's axis: a short interpolation per pixel, no search. Never across a
 //      missing, undecoded or non-consecutive boundary, nor a gap over maxGapPx + 1 pixels.
 namespace smx::algo {
 
 struct DecodeParams {
-  int maxGapPx = 12;          // link and fill distance along the axis (≈ 2.5 stripe periods)
+  int maxGapPx = 12;          // link search distance along the axis (≈ 2.5 stripe periods)
   int minSeparationQ8 = 192;  // a linked boundary lies at least this far along the axis (Q8 px)
   int minCurveVotes = 8;      // a curve's level needs this many agreeing windows (over its pixels)
   // A decoded curve is dropped when more than this share of its links to decoded boundaries
@@ -103,13 +101,8 @@ class StripeDecoder {
   void prepare(ConstBoundaryPlane b, ConstDirectionPlane d);
   template <bool kReference, class F>
   void eachBoundary(F f) const;
+  template <bool kReference>
   void link(ConstDirectionPlane d);
-  template <class PixelAt>
-  void linkLine(ConstDirectionPlane d, std::uint8_t axis, int length, PixelAt pixelAt);
-  template <class F>
-  void eachLine(F f);
-  template <class PixelAt>
-  int lineGroups(int length, PixelAt pixelAt);
   template <bool kReference>
   void vote();
   template <bool kReference>
@@ -145,9 +138,7 @@ class StripeDecoder {
   bool reference_ = false;
   // Per pixel, row-major without padding (index y · width + x):
   std::span<demux::UnitTable> units_;   // one table
-  int rowPixels_ = 0;                   // pixels whose scan line is their row (prepare())
-  std::span<std::int32_t> line_;        // the boundary pixels of one row or column
-  std::span<std::int32_t> groupStart_;  // their groups (lineGroups())
+  std::span<std::int32_t> line_;        // the fill's boundary pixels of one row or column
   std::span<std::uint8_t> axis_;        // the fill's kind of line per pixel (kRowAxis, kColumnAxis)
   std::span<std::int32_t> boundaries_;  // boundary pixels' indices, ascending (stats_ counts)
   std::span<std::uint8_t> code_;        // Boundary::transition (0: none)
