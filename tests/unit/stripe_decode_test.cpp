@@ -144,7 +144,8 @@ TEST(StripeDecode, CleanPatternGivesTheExactCoordinateEverywhereBetweenDecodable
     const Decoded d = decode(syn);
     const Errors e = compare(syn, d);
     EXPECT_EQ(e.wrong, 0) << angle << "°: max error " << e.maxAbs << " stripe";
-    // Every pixel more than two periods and the walk's reach from the border has a coordinate.
+    // Every pixel more than two periods and the longest gap (maxGapPx) from the border has a
+    // coordinate.
     int inner = 0;
     int innerDecoded = 0;
     for (int y = 12; y < syn.height - 12; ++y) {

@@ -97,7 +97,8 @@ void fillColumns(const ConstDepthPlane& r, int y, int cx, int first, int last,
     const std::int32_t lo = std::min(std::min(a, b), d);
     const std::int32_t hi = std::max(std::max(a, b), d);
     const std::int32_t sum = a + b + d;
-    columns[static_cast<std::size_t>(c - cx + 1)] = {
+    const int k = c - cx + 1;
+    columns[static_cast<std::size_t>(k)] = {
         static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(sum - lo - hi),
         static_cast<std::uint16_t>(hi), sum,
         std::int64_t{a} * a + std::int64_t{b} * b + std::int64_t{d} * d};
