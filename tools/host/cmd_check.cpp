@@ -27,8 +27,9 @@ using Json = nlohmann::ordered_json;
 // The check ran and a projector is not good (docs/cli.md).
 constexpr int kExitNotHealthy = 4;
 
-// How long the device may take for the raw capture.
-constexpr auto kCaptureTimeout = std::chrono::milliseconds(10'000);
+// How long the device may take for the raw capture: it first finishes the frame in hand, and a
+// board decoding two cameras may take seconds for that.
+constexpr auto kCaptureTimeout = std::chrono::milliseconds(30'000);
 
 struct CheckOptions {
   fs::path rig;
