@@ -268,12 +268,15 @@ TEST(PipelineSchedule, MergeAndEdgeFilterGiveTheReferenceOnRandomRanges) {
     int width;
     int missingPct;
     int outlierPct;
+    bool blankBands;  // each range without values in bands of columns, the bands shifted per range
   };
-  for (const Holes holes : {Holes{37, 20, 10}, Holes{150, 2, 2}}) {
+  for (const Holes holes :
+       {Holes{37, 20, 10, false}, Holes{150, 2, 2, false}, Holes{150, 2, 2, true}}) {
     for (const int ranges : {1, 2, 3, 5, 8}) {
       for (const int quantum : {1, 8, 64}) {
         SCOPED_TRACE(std::to_string(ranges) + " ranges, quantum " + std::to_string(quantum) +
-                     ", width " + std::to_string(holes.width));
+                     ", width " + std::to_string(holes.width) +
+                     (holes.blankBands ? ", blank bands" : ""));
         const int w = holes.width;
         const int h = 23;
         const auto pixels = static_cast<std::size_t>(w * h);
@@ -291,7 +294,8 @@ TEST(PipelineSchedule, MergeAndEdgeFilterGiveTheReferenceOnRandomRanges) {
             const int roll = percent(rng);
             int z = 9000 + 15 * x + noise(rng);
             z = z / quantum * quantum;
-            if (roll < holes.missingPct) {
+            if (roll < holes.missingPct ||
+                (holes.blankBands && (x / 6 + static_cast<int>(r)) % 3 == 0)) {
               z = kNoDepth;
             } else if (roll < holes.missingPct + holes.outlierPct) {
               z = 6000 + 40 * noise(rng);  // an outlier or another surface

@@ -1,9 +1,10 @@
 // The median-variant merge (range_merge.hpp; paper §4.2, "data merging stage": the ranges of
 // the separated patterns merged per image). merge<true> is the plain scalar definition,
 // merge<false> the schedule: the same sets and median, reached with fewer steps (pixels without
-// depth passed over, each row's 3 × 1 columns sorted and summed once for the three windows that
-// hold them, agreeing full windows taken whole from their columns, sets gathered in place, the
-// median by selection instead of sorting).
+// depth passed over; each chunk of a row's 3 × 3 windows, their extremes, sums, variance and
+// median, formed in vector lanes from 3 × 1 columns computed once for the three windows that
+// hold them; a pixel whose windows are each empty or full and agreeing decided from those
+// alone; otherwise sets gathered in place and the median by selection instead of sorting).
 #include "smx/algo/range_merge.hpp"
 
 #include <algorithm>
@@ -69,65 +70,81 @@ std::uint16_t medianBySelection(std::array<std::uint16_t, kMaxValues>& v, std::s
   return static_cast<std::uint16_t>((std::uint32_t{below} + *middle + 1) / 2);
 }
 
-// The schedule's 3 × 1 column of one range at one column of the row: its values sorted, their sum
-// and sum of squares. A 3 × 3 window is three columns side by side, and its extremes, sums and
-// median follow from theirs, each column computed once for the three windows that hold it.
-struct Column {
-  std::uint16_t lo;
-  std::uint16_t mid;
-  std::uint16_t hi;
-  std::int32_t sum;
-  std::int64_t squares;
-};
-
-// The columns of one chunk of a row: column cx − 1 + k at index k.
+// The schedule's 3 × 3 windows of one range along one chunk of a row, each from the three 3 × 1
+// columns it holds (every column computed once for the three windows): extremes, the median of
+// nine, the sums and 9·Σz² − (Σz)², which orders two full windows' variances as
+// compareVariance() does (equal counts: its n² factors cancel).
 constexpr int kChunk = 64;
-using ChunkColumns = std::array<Column, kChunk + 2>;
-
-// Columns first … last (inside the image) of range r around inner row y, for the chunk at cx.
-void fillColumns(const ConstDepthPlane& r, int y, int cx, int first, int last,
-                 ChunkColumns& columns) {
-  const std::uint16_t* above = r.rowPtr(y - 1);
-  const std::uint16_t* at = r.rowPtr(y);
-  const std::uint16_t* below = r.rowPtr(y + 1);
-  for (int c = first; c <= last; ++c) {
-    const std::int32_t a = above[c];
-    const std::int32_t b = at[c];
-    const std::int32_t d = below[c];
-    const std::int32_t lo = std::min(std::min(a, b), d);
-    const std::int32_t hi = std::max(std::max(a, b), d);
-    const std::int32_t sum = a + b + d;
-    const int k = c - cx + 1;
-    columns[static_cast<std::size_t>(k)] = {
-        static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(sum - lo - hi),
-        static_cast<std::uint16_t>(hi), sum,
-        std::int64_t{a} * a + std::int64_t{b} * b + std::int64_t{d} * d};
-  }
-}
+struct ChunkWindows {
+  std::array<std::uint16_t, kChunk> lo;
+  std::array<std::uint16_t, kChunk> hi;
+  std::array<std::uint16_t, kChunk> median;
+  std::array<std::int32_t, kChunk> sum;
+  std::array<std::int64_t, kChunk> squares;
+  std::array<std::int64_t, kChunk> spread;
+};
 
 std::int32_t medianOfThree(std::int32_t a, std::int32_t b, std::int32_t c) {
   return std::max(std::min(a, b), std::min(std::max(a, b), c));
 }
 
-// The median of the window whose columns are c[0], c[1], c[2]: of nine values, it is the median
-// of the largest column minimum, the median column median and the smallest column maximum.
-std::uint16_t medianOfColumns(const Column* c) {
-  const std::int32_t lows = std::max(std::max(c[0].lo, c[1].lo), c[2].lo);
-  const std::int32_t mids = medianOfThree(c[0].mid, c[1].mid, c[2].mid);
-  const std::int32_t highs = std::min(std::min(c[0].hi, c[1].hi), c[2].hi);
-  return static_cast<std::uint16_t>(medianOfThree(lows, mids, highs));
+// The windows of range r around inner pixels [xBegin, xEnd) of inner row y, window x at index
+// x − cx. Of nine values, the median is the median of the largest column minimum, the median
+// column median and the smallest column maximum.
+void fillWindows(const ConstDepthPlane& r, int y, int cx, int xBegin, int xEnd,
+                 ChunkWindows& windows) {
+  constexpr std::size_t kColumns = kChunk + 2;
+  std::array<std::int32_t, kColumns> lo{};
+  std::array<std::int32_t, kColumns> mid{};
+  std::array<std::int32_t, kColumns> hi{};
+  std::array<std::int32_t, kColumns> sum{};
+  std::array<std::int64_t, kColumns> squares{};
+  const std::uint16_t* above = r.rowPtr(y - 1) + xBegin - 1;
+  const std::uint16_t* at = r.rowPtr(y) + xBegin - 1;
+  const std::uint16_t* below = r.rowPtr(y + 1) + xBegin - 1;
+  const auto columns = static_cast<std::size_t>(xEnd - xBegin) + 2;
+  for (std::size_t c = 0; c < columns; ++c) {
+    const std::int32_t a = above[c];
+    const std::int32_t b = at[c];
+    const std::int32_t d = below[c];
+    lo[c] = std::min(std::min(a, b), d);
+    hi[c] = std::max(std::max(a, b), d);
+    sum[c] = a + b + d;
+    mid[c] = sum[c] - lo[c] - hi[c];
+    squares[c] = std::int64_t{a} * a + std::int64_t{b} * b + std::int64_t{d} * d;
+  }
+  const auto first = static_cast<std::size_t>(xBegin - cx);
+  for (std::size_t c = 0; c + 2 < columns; ++c) {
+    const std::size_t k = first + c;
+    // Values, not references into the arrays: the vectoriser takes no select of addresses.
+    const std::int32_t lo0 = lo[c];
+    const std::int32_t lo1 = lo[c + 1];
+    const std::int32_t lo2 = lo[c + 2];
+    const std::int32_t hi0 = hi[c];
+    const std::int32_t hi1 = hi[c + 1];
+    const std::int32_t hi2 = hi[c + 2];
+    const std::int32_t lows = std::max(std::max(lo0, lo1), lo2);
+    const std::int32_t highs = std::min(std::min(hi0, hi1), hi2);
+    const std::int32_t mids = medianOfThree(mid[c], mid[c + 1], mid[c + 2]);
+    const std::int32_t s = sum[c] + sum[c + 1] + sum[c + 2];
+    const std::int64_t q = squares[c] + squares[c + 1] + squares[c + 2];
+    windows.lo[k] = static_cast<std::uint16_t>(std::min(std::min(lo0, lo1), lo2));
+    windows.hi[k] = static_cast<std::uint16_t>(std::max(std::max(hi0, hi1), hi2));
+    windows.median[k] = static_cast<std::uint16_t>(medianOfThree(lows, mids, highs));
+    windows.sum[k] = s;
+    windows.squares[k] = q;
+    windows.spread[k] = kWindow * q - std::int64_t{s} * s;
+  }
 }
 
-// The window whose columns are c[0 … 3) as a set when all nine values lie in [low, low + span]
-// (so none is kNoDepth); false otherwise.
-bool fullWindow(const Column* c, std::int32_t low, std::uint32_t span, Set& set) {
-  const std::int32_t lo = std::min(std::min(c[0].lo, c[1].lo), c[2].lo);
-  const std::int32_t hi = std::max(std::max(c[0].hi, c[1].hi), c[2].hi);
-  if (lo < low || static_cast<std::uint32_t>(hi - low) > span) {
+// Window k as a set when all nine values lie in [low, low + span] (so none is kNoDepth); false
+// otherwise.
+bool fullWindow(const ChunkWindows& windows, std::size_t k, std::int32_t low, std::uint32_t span,
+                Set& set) {
+  if (windows.lo[k] < low || static_cast<std::uint32_t>(windows.hi[k] - low) > span) {
     return false;
   }
-  set = {kWindow, std::int64_t{c[0].sum} + c[1].sum + c[2].sum,
-         c[0].squares + c[1].squares + c[2].squares};
+  set = {kWindow, windows.sum[k], windows.squares[k]};
   return true;
 }
 
@@ -188,6 +205,58 @@ std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std
   return 2 * bestSupport > present ? best : kNoDepth;
 }
 
+// The merged confidence from the smallest predicted error among the agreeing ranges.
+std::uint8_t mergedConfidence(std::int32_t error, int agreeing) {
+  const std::int32_t e = (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
+  return static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+}
+
+// Where the merged confidence goes, with the ranges' confidences at the pixel (none: no
+// confidence output).
+struct ConfidenceAt {
+  const std::array<const std::uint8_t*, kMaxRanges>* rows = nullptr;  // the ranges' at the row
+  int x = 0;
+  std::uint8_t* out = nullptr;
+};
+
+// The schedule's shortcut at an inner pixel where every range's window is either empty or nine
+// values agreeing with the reference, and no two full windows' variances tie: the fold then
+// keeps one full window whole (counts equal, smaller variance), and the median is that
+// window's. False, with nothing written, where the fold would do anything else.
+bool mergeFullWindows(std::span<const ChunkWindows> windows, std::size_t k, std::int32_t low,
+                      std::uint32_t span, std::uint16_t& out, const ConfidenceAt& confidence) {
+  const ChunkWindows* best = nullptr;
+  std::int32_t error = 255;
+  int agreeing = 0;
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    const ChunkWindows& w = windows[i];
+    if (w.hi[k] == kNoDepth) {
+      continue;  // empty: no value at the pixel either, so no part in the confidence
+    }
+    if (w.lo[k] < low || static_cast<std::uint32_t>(w.hi[k] - low) > span) {
+      return false;
+    }
+    if (confidence.out != nullptr) {
+      const std::int32_t e = 255 - (*confidence.rows)[i][confidence.x];
+      error = e < error ? e : error;
+      ++agreeing;
+    }
+    if (best == nullptr || w.spread[k] < best->spread[k]) {
+      best = &w;
+    } else if (w.spread[k] == best->spread[k]) {
+      return false;  // a tie: the fold takes the union
+    }
+  }
+  if (best == nullptr) {
+    return false;
+  }
+  out = best->median[k];
+  if (confidence.out != nullptr) {
+    *confidence.out = mergedConfidence(error, agreeing);
+  }
+  return true;
+}
+
 template <bool kReference>
 Result<void> merge(std::span<const ConstDepthPlane> ranges,
                    std::span<const ImageView<const std::uint8_t>> confidences, DepthPlane out,
@@ -227,7 +296,9 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
   std::array<std::uint16_t, kMaxValues> chosen{};
   std::array<std::uint16_t, kWindow> next{};
   std::array<std::uint16_t, kMaxRanges> centre{};
-  std::array<ChunkColumns, kMaxRanges> columns{};
+  std::array<ChunkWindows, kMaxRanges> windows{};
+  std::array<const std::uint16_t*, kMaxRanges> centreRows{};
+  std::array<const std::uint8_t*, kMaxRanges> confidenceRows{};
   const int yEnd = rows.end < h ? rows.end : h;
   for (int y = rows.begin > 0 ? rows.begin : 0; y < yEnd; ++y) {
     std::uint16_t* o = out.rowPtr(y);
@@ -235,11 +306,17 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
     const int y0 = y > 0 ? y - 1 : 0;
     const int y1 = y + 1 < h ? y + 1 : h - 1;
     const bool innerRow = !kReference && y > 0 && y + 1 < h;
+    for (std::size_t i = 0; i < n; ++i) {
+      centreRows[i] = ranges[i].rowPtr(y);
+      confidenceRows[i] = oc != nullptr ? confidences[i].rowPtr(y) : nullptr;
+    }
     for (int cx = 0; cx < w; cx += kChunk) {
       const int cxEnd = cx + kChunk < w ? cx + kChunk : w;
-      if (innerRow) {
+      const int innerBegin = cx > 0 ? cx : 1;
+      const int innerEnd = cxEnd < w ? cxEnd : w - 1;
+      if (innerRow && innerBegin < innerEnd) {
         for (std::size_t i = 0; i < n; ++i) {
-          fillColumns(ranges[i], y, cx, cx > 0 ? cx - 1 : 0, cxEnd < w ? cxEnd : w - 1, columns[i]);
+          fillWindows(ranges[i], y, cx, innerBegin, innerEnd, windows[i]);
         }
       }
       for (int x = cx; x < cxEnd; ++x) {
@@ -248,14 +325,18 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
           oc[x] = 0;
         }
         std::uint32_t any = 0;
+        int present = 0;
         for (std::size_t i = 0; i < n; ++i) {
-          centre[i] = ranges[i].rowPtr(y)[x];
+          centre[i] = centreRows[i][x];
           any |= centre[i];
+          present += centre[i] != kNoDepth ? 1 : 0;
         }
         if (!kReference && any == kNoDepth) {
           continue;
         }
-        const std::uint16_t ref = reference(centre, n, tolerance);
+        // One value alone is the reference: with the others 0, it is their bitwise or.
+        const std::uint16_t ref = !kReference && present == 1 ? static_cast<std::uint16_t>(any)
+                                                              : reference(centre, n, tolerance);
         if (ref == kNoDepth) {
           continue;
         }
@@ -269,9 +350,12 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         const int x0 = x > 0 ? x - 1 : 0;
         const int x1 = x + 1 < w ? x + 1 : w - 1;
         const bool inner = innerRow && x > 0 && x + 1 < w;
-        const auto windowColumns = [&](std::size_t i) {
-          return &columns[i][static_cast<std::size_t>(x - cx)];
-        };
+        const auto k = static_cast<std::size_t>(x - cx);
+        if (inner && mergeFullWindows({windows.data(), n}, k, low, span, o[x],
+                                      oc != nullptr ? ConfidenceAt{&confidenceRows, x, &oc[x]}
+                                                    : ConfidenceAt{})) {
+          continue;
+        }
         Set best;
         std::size_t lazy = kMaxRanges;  // none
         std::int32_t error = 255;
@@ -281,7 +365,7 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
             continue;  // outvoted
           }
           if (oc != nullptr && centre[i] != kNoDepth) {
-            const std::int32_t e = 255 - confidences[i].rowPtr(y)[x];
+            const std::int32_t e = 255 - confidenceRows[i][x];
             error = e < error ? e : error;
             ++agreeing;
           }
@@ -290,8 +374,8 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
               kReference ? next.data() : chosen.data() + static_cast<std::size_t>(best.count);
           Set set;
           // The schedule takes a full 3 × 3 window that agrees throughout without a branch per
-          // value: its columns' extremes tell.
-          const bool full = inner && fullWindow(windowColumns(i), low, span, set);
+          // value: its extremes tell.
+          const bool full = inner && fullWindow(windows[i], k, low, span, set);
           if (!full) {
             for (int yy = y0; yy <= y1; ++yy) {
               const std::uint16_t* row = r.rowPtr(yy);
@@ -329,8 +413,8 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
             }
           } else if (gathered != chosen.data() + at) {
             // Ascending: where the schedule moves a set to the front, the ranges may overlap.
-            for (std::size_t k = 0; k < static_cast<std::size_t>(set.count); ++k) {
-              chosen[at + k] = gathered[k];
+            for (std::size_t j = 0; j < static_cast<std::size_t>(set.count); ++j) {
+              chosen[at + j] = gathered[j];
             }
           }
           lazy = keep == 1 && full ? i : kMaxRanges;
@@ -342,13 +426,10 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         if constexpr (kReference) {
           o[x] = medianBySorting(chosen, count);
         } else {
-          o[x] = lazy < kMaxRanges ? medianOfColumns(windowColumns(lazy))
-                                   : medianBySelection(chosen, count);
+          o[x] = lazy < kMaxRanges ? windows[lazy].median[k] : medianBySelection(chosen, count);
         }
         if (oc != nullptr) {
-          const std::int32_t e =
-              (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
-          oc[x] = static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+          oc[x] = mergedConfidence(error, agreeing);
         }
       }
     }
