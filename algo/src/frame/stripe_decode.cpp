@@ -28,8 +28,6 @@ using decode::along;
 using decode::flat;
 using decode::Hit;
 using decode::kNone;
-using decode::packedX;
-using decode::packedY;
 using decode::PointQ8;
 using decode::Unit;
 using decode::unitOf;
@@ -282,9 +280,7 @@ void StripeDecoder::link(ConstDirectionPlane d) {
 // window of 6 consecutive transitions in it.
 template <bool kReference>
 void StripeDecoder::vote() {
-  const auto indexOf = [this](std::int32_t packed) {
-    return flat(packedX(packed), packedY(packed), width_);
-  };
+  const auto indexOf = [](std::int32_t link) { return static_cast<std::size_t>(link); };
   const auto kindAt = [this](std::size_t i) {
     return static_cast<stripe::Transition>(code_[i] - 1);
   };
@@ -482,7 +478,7 @@ void StripeDecoder::joinCurves() {
     total_[i] = 0;
   });
   const auto linkedLevel = [this](std::int32_t link) -> std::int32_t {
-    return link == kNone ? 0 : level_[flat(packedX(link), packedY(link), width_)];
+    return link == kNone ? 0 : level_[static_cast<std::size_t>(link)];
   };
   const std::int32_t ratio = params_.maxGapRatioPct;
   eachBoundary<kReference>([&](std::size_t i) {

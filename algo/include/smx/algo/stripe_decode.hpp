@@ -143,7 +143,7 @@ class StripeDecoder {
   std::span<std::int32_t> boundaries_;  // boundary pixels' indices, ascending (stats_ counts)
   std::span<std::uint8_t> code_;        // Boundary::transition (0: none)
   std::span<Shift> shift_;              // where the boundary lies
-  std::span<std::int32_t> next_;        // linked boundary ahead: y << 16 | x, or −1
+  std::span<std::int32_t> next_;        // linked boundary ahead: its pixel index, or −1
   std::span<std::int32_t> prev_;        // behind
   std::span<std::int16_t> gapNext_;     // distance to the link ahead along the axis, Q8 px
   std::span<std::int16_t> gapPrev_;     // behind

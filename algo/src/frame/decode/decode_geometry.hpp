@@ -1,7 +1,7 @@
 #pragma once
 
-// The decoder's shared geometry (stripe_decode.hpp): Q8 positions, Q1.14 unit vectors, packed
-// pixel links and the half-pixel walk along an axis, with the walks its schedules take. Internal
+// The decoder's shared geometry (stripe_decode.hpp): Q8 positions, Q1.14 unit vectors, pixel
+// links and the half-pixel walk along an axis, with the walks its schedules take. Internal
 // to src/frame (stripe_decode.cpp).
 
 #include <cstddef>
@@ -41,17 +41,7 @@ constexpr std::size_t flat(int x, int y, int width) {
          static_cast<std::size_t>(x);
 }
 
-constexpr std::int32_t pack(int x, int y) {
-  return (y << 16) | x;
-}
-constexpr int packedX(std::int32_t p) {
-  return p & 0xFFFF;
-}
-constexpr int packedY(std::int32_t p) {
-  return p >> 16;
-}
-
-// A walk's result: the boundary pixel it stopped at, packed (y << 16 | x), or kNone, and where
+// A walk's result: the boundary pixel it stopped at (its index y · width + x), or kNone, and where
 // that boundary lies along the walk (Q8).
 struct Hit {
   std::int32_t at;
@@ -75,7 +65,7 @@ Hit nearestInBlock(std::span<const std::uint8_t> code, int width, int height, in
       }
       const std::int32_t dist = distance(qx, qy, i);
       if (dist >= 0 && (best == kNone || dist < bestDistance)) {
-        best = pack(qx, qy);
+        best = i;
         bestDistance = dist;
       }
     }
@@ -96,7 +86,7 @@ Hit nearestInInnerBlock(const std::uint8_t* p, std::size_t width, int x0, int y0
     }
     const std::int32_t dist = distance(qx, qy, q);
     if (dist >= 0 && (best == kNone || dist < bestDistance)) {
-      best = pack(qx, qy);
+      best = q;
       bestDistance = dist;
     }
   };
