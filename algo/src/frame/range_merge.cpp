@@ -137,11 +137,16 @@ void fillWindows(const ConstDepthPlane& r, int y, int cx, int xBegin, int xEnd,
   }
 }
 
-// Window k as a set when all nine values lie in [low, low + span] (so none is kNoDepth); false
-// otherwise.
+// Whether all nine values of window k lie in [low, low + span] (so none is kNoDepth).
+bool agreesThroughout(const ChunkWindows& windows, std::size_t k, std::int32_t low,
+                      std::uint32_t span) {
+  return windows.lo[k] >= low && static_cast<std::uint32_t>(windows.hi[k] - low) <= span;
+}
+
+// Window k as a set when it agrees throughout; false otherwise.
 bool fullWindow(const ChunkWindows& windows, std::size_t k, std::int32_t low, std::uint32_t span,
                 Set& set) {
-  if (windows.lo[k] < low || static_cast<std::uint32_t>(windows.hi[k] - low) > span) {
+  if (!agreesThroughout(windows, k, low, span)) {
     return false;
   }
   set = {kWindow, windows.sum[k], windows.squares[k]};
@@ -162,19 +167,9 @@ void gatherWindow(const ConstDepthPlane& r, int x, int y, std::uint16_t* v) {
 constexpr std::array<std::int32_t, kMaxRanges + 1> kInverseSqrtQ8 = {256, 256, 181, 148, 128,
                                                                      114, 105, 97,  91};
 
-// The reference value at a pixel from the ranges' centre values (0: none), or 0 when no value
-// has a strict majority within the tolerance.
-std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std::size_t n,
-                        const DepthTolerance& tolerance) {
-  int present = 0;
-  std::uint16_t first = kNoDepth;
-  for (std::size_t i = 0; i < n; ++i) {
-    present += centre[i] != kNoDepth ? 1 : 0;
-    first = first == kNoDepth ? centre[i] : first;
-  }
-  if (present <= 1) {
-    return first;  // one range alone passes (or none: no depth)
-  }
+// reference() where two or more ranges have a value.
+std::uint16_t voteForReference(const std::array<std::uint16_t, kMaxRanges>& centre, std::size_t n,
+                               int present, std::uint16_t first, const DepthTolerance& tolerance) {
   // Usually every value agrees with the first: then it has all the support.
   const std::int32_t firstTol = tolerance.at(first);
   bool all = true;
@@ -205,6 +200,14 @@ std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std
   return 2 * bestSupport > present ? best : kNoDepth;
 }
 
+// The reference value at a pixel from the ranges' centre values (0: none), of which `present`
+// are values and `first` is the first, or 0 when no value has a strict majority within the
+// tolerance. One range alone passes (or none: no depth) without a vote.
+std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std::size_t n,
+                        int present, std::uint16_t first, const DepthTolerance& tolerance) {
+  return present <= 1 ? first : voteForReference(centre, n, present, first, tolerance);
+}
+
 // The merged confidence from the smallest predicted error among the agreeing ranges.
 std::uint8_t mergedConfidence(std::int32_t error, int agreeing) {
   const std::int32_t e = (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
@@ -233,7 +236,7 @@ bool mergeFullWindows(std::span<const ChunkWindows> windows, std::size_t k, std:
     if (w.hi[k] == kNoDepth) {
       continue;  // empty: no value at the pixel either, so no part in the confidence
     }
-    if (w.lo[k] < low || static_cast<std::uint32_t>(w.hi[k] - low) > span) {
+    if (!agreesThroughout(w, k, low, span)) {
       return false;
     }
     if (confidence.out != nullptr) {
@@ -324,19 +327,17 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         if (oc != nullptr) {
           oc[x] = 0;
         }
-        std::uint32_t any = 0;
         int present = 0;
+        std::uint16_t first = kNoDepth;
         for (std::size_t i = 0; i < n; ++i) {
           centre[i] = centreRows[i][x];
-          any |= centre[i];
           present += centre[i] != kNoDepth ? 1 : 0;
+          first = first == kNoDepth ? centre[i] : first;
         }
-        if (!kReference && any == kNoDepth) {
+        if (!kReference && present == 0) {
           continue;
         }
-        // One value alone is the reference: with the others 0, it is their bitwise or.
-        const std::uint16_t ref = !kReference && present == 1 ? static_cast<std::uint16_t>(any)
-                                                              : reference(centre, n, tolerance);
+        const std::uint16_t ref = reference(centre, n, present, first, tolerance);
         if (ref == kNoDepth) {
           continue;
         }
@@ -347,8 +348,6 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         const auto agrees = [low, span](std::uint16_t z) {
           return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
         };
-        const int x0 = x > 0 ? x - 1 : 0;
-        const int x1 = x + 1 < w ? x + 1 : w - 1;
         const bool inner = innerRow && x > 0 && x + 1 < w;
         const auto k = static_cast<std::size_t>(x - cx);
         if (inner && mergeFullWindows({windows.data(), n}, k, low, span, o[x],
@@ -356,6 +355,8 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
                                                     : ConfidenceAt{})) {
           continue;
         }
+        const int x0 = x > 0 ? x - 1 : 0;
+        const int x1 = x + 1 < w ? x + 1 : w - 1;
         Set best;
         std::size_t lazy = kMaxRanges;  // none
         std::int32_t error = 255;

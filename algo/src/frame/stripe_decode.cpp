@@ -280,7 +280,7 @@ void StripeDecoder::link(ConstDirectionPlane d) {
 // window of 6 consecutive transitions in it.
 template <bool kReference>
 void StripeDecoder::vote() {
-  const auto indexOf = [](std::int32_t link) { return static_cast<std::size_t>(link); };
+  const auto indexOf = [](std::int32_t link) { return static_cast<std::size_t>(link); };  // ≠ kNone
   const auto kindAt = [this](std::size_t i) {
     return static_cast<stripe::Transition>(code_[i] - 1);
   };
