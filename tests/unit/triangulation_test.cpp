@@ -6,8 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "smx/algo/depth_trust.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/pattern_image.hpp"
 
@@ -354,6 +358,100 @@ TEST(DistortedProjector, RunMatchesDepthAtWithoutTouchingTheHeap) {
     }
   }
   EXPECT_GT(filled, w * h / 3);
+}
+
+constexpr int kOneOverPxQ24 = 1 << 24;  // 1 stripe per px in Q16, times the width's Q8
+
+// The one-pass schedule of triangulation and trust (triangulateTrusted) against run() followed
+// by trustDepth(), bit for bit: a surface's stripe plane with noise, holes of every negative
+// value, jumps, values near and past the end of the sequence, ramps at the resolvable limit, for
+// an undistorted and a distorted projector, with parameters at and between their limits; the
+// schedule never touches the heap.
+TEST(TriangulationWithTrust, OnePassGivesTheReferenceOnRandomStripes) {
+  for (const bool distorted : {false, true}) {
+    Rig rig = makeRig();
+    rig.projectors[0].pattern.stripePx = 14;  // about 5 px in the camera: resolvable
+    if (distorted) {
+      rig.projectors[0].dist = {-0.05, 0.01, 0.001, -0.0005, 0.0};
+    }
+    const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
+    ASSERT_TRUE(tables) << tables.error();
+    std::vector<std::byte> memory;
+    const auto t = triangulatorFor(*tables, memory);
+    ASSERT_TRUE(t);
+    const int w = rig.cameras[0].width;
+    const int h = rig.cameras[0].height;
+    std::mt19937 rng(distorted ? 5 : 3);
+    std::uniform_int_distribution<int> percent(0, 99);
+    std::uniform_int_distribution<int> noise(-300, 300);
+    std::vector<StripeQ16> stripe(static_cast<std::size_t>(w * h), kNoStripe);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const auto i = static_cast<std::size_t>(y * w + x);
+        const Sample s = sampleAt(rig, x, y, 0.6 + 0.002 * x + 0.0005 * y);
+        const int roll = percent(rng);
+        if (y >= 10 && y < 40) {
+          // Ramps at the default's resolvable limit (2^24 / 640 Q16 per px) and either side of
+          // it, in bands of three equal rows.
+          stripe[i] =
+              x * (kOneOverPxQ24 / DepthTrustParams{}.minStripeWidthQ8 - 1 + (y - 10) / 3 % 3);
+        } else if (roll < 3 || !s.stripe) {
+          const std::array<StripeQ16, 3> holes{kNoStripe, -1, -70000};
+          stripe[i] = holes[static_cast<std::size_t>(roll % 3)];
+        } else if (roll < 4) {
+          stripe[i] = Triangulator::kMaxStripe - 1 - roll;  // the end of the sequence
+        } else if (roll < 5) {
+          stripe[i] = Triangulator::kMaxStripe + roll;
+        } else if (roll < 6) {
+          stripe[i] = static_cast<StripeQ16>(percent(rng) * kStripeOne * 2);  // a jump
+        } else if (roll < 7 && y > 200) {
+          stripe[i] = std::numeric_limits<StripeQ16>::max() - percent(rng);  // hostile
+        } else {
+          stripe[i] = std::max(0, q16(*s.stripe) + noise(rng));
+        }
+      }
+    }
+    const auto stripePlane = *ConstStripePlane::packed(stripe, w, h);
+    DepthTrustParams defaults;
+    std::vector<DepthTrustParams> variants(6, defaults);
+    variants[1].minStripeWidthQ8 = 0;
+    variants[2].minStripeWidthQ8 = 4096;
+    variants[3].boundaryErrorQ8 = 0;
+    variants[3].errorMargin = 1;
+    variants[4].boundaryErrorQ8 = 256;
+    variants[4].errorMargin = 10;
+    variants[5].tolerance = {1, 0};
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+      SCOPED_TRACE((distorted ? "distorted, parameters " : "undistorted, parameters ") +
+                   std::to_string(v));
+      std::vector<std::uint16_t> depth(stripe.size(), 1234);
+      std::vector<std::uint8_t> confidence(stripe.size(), 7);
+      std::vector<std::uint16_t> depthReference(stripe.size(), 4321);
+      std::vector<std::uint8_t> confidenceReference(stripe.size(), 9);
+      ASSERT_TRUE(t->run(stripePlane, *DepthPlane::packed(depthReference, w, h)));
+      ASSERT_TRUE(trustDepth(*t, stripePlane, *DepthPlane::packed(depthReference, w, h),
+                             *ImageView<std::uint8_t>::packed(confidenceReference, w, h),
+                             variants[v]));
+      const test::AllocationCounter counter;
+      ASSERT_TRUE(triangulateTrusted(*t, stripePlane, *DepthPlane::packed(depth, w, h),
+                                     *ImageView<std::uint8_t>::packed(confidence, w, h),
+                                     variants[v]));
+      EXPECT_EQ(counter.allocations(), 0U);
+      EXPECT_EQ(depth, depthReference);
+      EXPECT_EQ(confidence, confidenceReference);
+      const auto kept = std::count_if(depthReference.begin(), depthReference.end(),
+                                      [](std::uint16_t z) { return z != kNoDepth; });
+      if (v == 0 || v == 1 || v == 3) {  // the others keep (next to) nothing by design
+        EXPECT_GT(kept, w * h / 4);
+      }
+    }
+    std::vector<std::uint16_t> small(static_cast<std::size_t>((w - 1) * h));
+    std::vector<std::uint8_t> confidence(stripe.size());
+    const auto r = triangulateTrusted(*t, stripePlane, *DepthPlane::packed(small, w - 1, h),
+                                      *ImageView<std::uint8_t>::packed(confidence, w, h), defaults);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, Errc::kSizeMismatch);
+  }
 }
 
 // An undistorted projector keeps the closed form (the tests above): one shared numerator, and

@@ -224,10 +224,16 @@ Result<void> CameraPipeline::triangulateProjector(int projector, DepthPlane scra
   }
   // The unfiltered range image goes to the lane's scratch plane first. Untrusted depths go
   // before the edge filter, so that they cannot cut good neighbours.
-  if (auto ok = triangulator->run(stripes_[i], scratch); !ok) {
-    return ok;
-  }
-  if (auto ok = trustDepth(*triangulator, stripes_[i], scratch, confidences_[i], trust_); !ok) {
+  if (reference_) {
+    if (auto ok = triangulator->run(stripes_[i], scratch); !ok) {
+      return ok;
+    }
+    if (auto ok = trustDepth(*triangulator, stripes_[i], scratch, confidences_[i], trust_); !ok) {
+      return ok;
+    }
+  } else if (auto ok =
+                 triangulateTrusted(*triangulator, stripes_[i], scratch, confidences_[i], trust_);
+             !ok) {
     return ok;
   }
   const auto edges = reference_ ? removeDepthEdgesReference : removeDepthEdges;

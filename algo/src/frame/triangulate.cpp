@@ -76,12 +76,13 @@ Result<Triangulator> Triangulator::create(const TriangulationTables& tables, Are
 
 template <bool kPerPixel>
 void Triangulator::runRows(ConstStripePlane stripe, DepthPlane depth) const {
+  const Lookup l = lookup();
   for (int y = 0; y < height_; ++y) {
     const StripeQ16* s = stripe.rowPtr(y);
     std::uint16_t* z = depth.rowPtr(y);
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
     for (int x = 0; x < width_; ++x) {
-      z[x] = depthOf<kPerPixel>(row + static_cast<std::size_t>(x), s[x]);
+      z[x] = l.depth<kPerPixel>(row + static_cast<std::size_t>(x), s[x]);
     }
   }
 }

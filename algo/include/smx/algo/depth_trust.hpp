@@ -58,4 +58,11 @@ struct DepthTrustParams {
                                       DepthPlane depth, ImageView<std::uint8_t> confidence,
                                       const DepthTrustParams& params);
 
+// Triangulator::run() into `depth` followed by trustDepth(), in one pass: the same planes bit for
+// bit (the schedule; those two are the reference).
+[[nodiscard]] Result<void> triangulateTrusted(const Triangulator& triangulator,
+                                              ConstStripePlane stripe, DepthPlane depth,
+                                              ImageView<std::uint8_t> confidence,
+                                              const DepthTrustParams& params);
+
 }  // namespace smx::algo

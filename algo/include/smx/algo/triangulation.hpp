@@ -100,6 +100,50 @@ class Triangulator {
   // bound the tables' integer ranges).
   static constexpr StripeQ16 kMaxStripe = 198 * kStripeOne;
 
+  // The per-pixel tables as plain pointers, with the depth formula: a loop that stores bytes
+  // (which may alias anything) keeps these in registers, where it would reload the spans after
+  // every store.
+  struct Lookup {
+    const std::int32_t* base = nullptr;
+    const std::int32_t* slope = nullptr;
+    const std::int8_t* sense = nullptr;
+    const PixelNumerator* numerators = nullptr;  // per pixel, for a distorted projector
+    std::int64_t numeratorBase = 0;
+    std::int64_t numeratorSlope = 0;
+
+    // depthAt for the pixel of index y · width + x. kPerPixel: perPixelNumerators() (chosen
+    // once per loop, so that the shared-numerator loop does no extra work).
+    template <bool kPerPixel>
+    [[nodiscard]] std::uint16_t depth(std::size_t i, StripeQ16 s) const {
+      const std::int8_t sign = sense[i];
+      if (s < 0 || s >= kMaxStripe || sign == 0) {  // kNoStripe is negative
+        return kNoDepth;
+      }
+      std::int64_t den = (std::int64_t{base[i]} << 16) + std::int64_t{slope[i]} * s;
+      std::int64_t num = 0;
+      if constexpr (kPerPixel) {
+        const PixelNumerator& n = numerators[i];
+        const std::int64_t s2 = (std::int64_t{s} * s) >> 16;  // s ≥ 0 here: the floor
+        const std::int64_t s3 = (s2 * s) >> 16;
+        num = n.base + n.slope * s + n.square * s2 + n.cube * s3;
+      } else {
+        num = numeratorBase + numeratorSlope * s;
+      }
+      if (den == 0 || (den > 0) != (sign > 0)) {
+        return kNoDepth;
+      }
+      if (den < 0) {
+        den = -den;
+        num = -num;
+      }
+      if (num <= 0) {
+        return kNoDepth;
+      }
+      const std::int64_t z = (num + den / 2) / den;
+      return z >= 1 && z <= 65535 ? static_cast<std::uint16_t>(z) : kNoDepth;
+    }
+  };
+
   // For tables of an undistorted projector (9 bytes per pixel).
   [[nodiscard]] static Result<std::size_t> workspaceBytes(int width, int height);
   // For these tables (41 bytes per pixel with per-pixel numerators).
@@ -114,7 +158,16 @@ class Triangulator {
   [[nodiscard]] std::uint16_t depthAt(int x, int y, StripeQ16 s) const {
     const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                           static_cast<std::size_t>(x);
-    return numerators_.empty() ? depthOf<false>(i, s) : depthOf<true>(i, s);
+    const Lookup l = lookup();
+    return perPixelNumerators() ? l.depth<true>(i, s) : l.depth<false>(i, s);
+  }
+
+  // Whether the numerators are per pixel (a distorted projector): Lookup::depth's kPerPixel.
+  [[nodiscard]] bool perPixelNumerators() const { return !numerators_.empty(); }
+
+  [[nodiscard]] Lookup lookup() const {
+    return {base_.data(),       slope_.data(),  sense_.data(),
+            numerators_.data(), numeratorBase_, numeratorSlope_};
   }
 
   // depthAt for every pixel. Both planes must be width × height.
@@ -125,38 +178,6 @@ class Triangulator {
 
  private:
   Triangulator() = default;
-
-  // kPerPixel: the numerator is the pixel's own (distorted projector), chosen once per call of
-  // run() so that the shared-numerator loop does no extra work.
-  template <bool kPerPixel>
-  [[nodiscard]] std::uint16_t depthOf(std::size_t i, StripeQ16 s) const {
-    const std::int8_t sense = sense_[i];
-    if (s < 0 || s >= kMaxStripe || sense == 0) {  // kNoStripe is negative
-      return kNoDepth;
-    }
-    std::int64_t den = (std::int64_t{base_[i]} << 16) + std::int64_t{slope_[i]} * s;
-    std::int64_t num = 0;
-    if constexpr (kPerPixel) {
-      const PixelNumerator& n = numerators_[i];
-      const std::int64_t s2 = (std::int64_t{s} * s) >> 16;  // s ≥ 0 here: the floor
-      const std::int64_t s3 = (s2 * s) >> 16;
-      num = n.base + n.slope * s + n.square * s2 + n.cube * s3;
-    } else {
-      num = numeratorBase_ + numeratorSlope_ * s;
-    }
-    if (den == 0 || (den > 0) != (sense > 0)) {
-      return kNoDepth;
-    }
-    if (den < 0) {
-      den = -den;
-      num = -num;
-    }
-    if (num <= 0) {
-      return kNoDepth;
-    }
-    const std::int64_t z = (num + den / 2) / den;
-    return z >= 1 && z <= 65535 ? static_cast<std::uint16_t>(z) : kNoDepth;
-  }
 
   template <bool kPerPixel>
   void runRows(ConstStripePlane stripe, DepthPlane depth) const;
