@@ -77,15 +77,25 @@ std::pair<int, int> majorityFound(const std::array<std::int16_t, stripe::kWindow
   return {candidate, votes};
 }
 
-// Bit k set where chain[k] (lo ≤ k ≤ hi) is a plus transition.
-unsigned plusBitsOf(const std::array<stripe::Transition, 2 * kChainEachWay + 1>& chain, int lo,
-                    int hi) {
-  unsigned bits = 0;
-  for (int k = lo; k <= hi; ++k) {
-    bits |= stripe::isPlus(chain[static_cast<std::size_t>(k)]) ? 1U << k : 0U;
+// Per boundary code (transition + 1; 0: none): whether its transition is a plus one, and its
+// first colour's index, for the vote's packed chains.
+constexpr std::array<unsigned, stripe::kTransitions + 1> kPlusOfCode = [] {
+  std::array<unsigned, stripe::kTransitions + 1> table{};
+  for (std::size_t t = 0; t < stripe::kTransitions; ++t) {
+    table[t + 1] = stripe::isPlus(static_cast<stripe::Transition>(t)) ? 1U : 0U;
   }
-  return bits;
-}
+  return table;
+}();
+constexpr std::array<unsigned, stripe::kTransitions + 1> kFromOfCode = [] {
+  std::array<unsigned, stripe::kTransitions + 1> table{};
+  for (std::size_t t = 0; t < stripe::kTransitions; ++t) {
+    table[t + 1] =
+        static_cast<unsigned>(stripe::indexOf(stripe::from(static_cast<stripe::Transition>(t))));
+  }
+  return table;
+}();
+constexpr unsigned kWindowMask = (1U << stripe::kWindowTransitions) - 1;
+static_assert(stripe::windowCode(stripe::Colour::kBlue, 5) == 2 * (kWindowMask + 1) + 5);
 
 Result<void> validate(int width, int height, const DecodeParams& p) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192) {
@@ -297,73 +307,8 @@ void StripeDecoder::vote() {
   const auto stepsAhead = [&](std::size_t cur, std::size_t n) {
     return stripe::from(kindAt(n)) == stripe::to(kindAt(cur)) && linksBack(prev_, n, cur);
   };
-  // The schedule decides each pixel's two steps once, not once per chain through it: bit 0 the
-  // step behind, bit 1 the step ahead, in candidate_ (free until step 3 sets it).
-  if constexpr (!kReference) {
-    eachBoundary<false>([&](std::size_t i) {
-      const bool back = prev_[i] != kNone && stepsBack(i, indexOf(prev_[i]));
-      const bool ahead = next_[i] != kNone && stepsAhead(i, indexOf(next_[i]));
-      candidate_[i] = static_cast<std::int16_t>((back ? 1 : 0) | (ahead ? 2 : 0));
-    });
-  }
-  const auto chains = [&](std::size_t cur, std::size_t n, int bit) {
-    if constexpr (kReference) {
-      return bit == 1 ? stepsBack(cur, n) : stepsAhead(cur, n);
-    } else {
-      return (candidate_[cur] & bit) != 0;
-    }
-  };
-  eachBoundary<kReference>([&](std::size_t i) {
-    own_[i] = 0;
-    votes_[i] = 0;
-    std::array<stripe::Transition, 2 * kChainEachWay + 1> chain{};
-    chain[kChainEachWay] = kindAt(i);
-    int lo = kChainEachWay;
-    for (std::size_t cur = i; lo > 0;) {
-      const std::int32_t link = prev_[cur];
-      if (link == kNone) {
-        break;
-      }
-      const std::size_t n = indexOf(link);
-      if (!chains(cur, n, 1)) {
-        break;
-      }
-      chain[static_cast<std::size_t>(--lo)] = kindAt(n);
-      cur = n;
-    }
-    int hi = kChainEachWay;
-    for (std::size_t cur = i; hi < 2 * kChainEachWay;) {
-      const std::int32_t link = next_[cur];
-      if (link == kNone) {
-        break;
-      }
-      const std::size_t n = indexOf(link);
-      if (!chains(cur, n, 2)) {
-        break;
-      }
-      chain[static_cast<std::size_t>(++hi)] = kindAt(n);
-      cur = n;
-    }
-    // Windows start at j (chain index) with lo ≤ j, j + 5 ≤ hi, j ≤ kChainEachWay ≤ j + 5.
-    std::array<std::int16_t, stripe::kWindowTransitions> found{};
-    int count = 0;
-    // The schedule reads every window's code from one word of the chain's plus bits: the links
-    // above chained the colours, so no window can fail decodeWindow's chain check.
-    const unsigned plusBits = kReference ? 0U : plusBitsOf(chain, lo, hi);
-    for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
-      const auto window =
-          static_cast<int>((plusBits >> j) & ((1U << stripe::kWindowTransitions) - 1));
-      const int index = kReference
-                            ? stripe::decodeWindow(
-                                  std::span<const stripe::Transition, stripe::kWindowTransitions>(
-                                      chain.data() + j, stripe::kWindowTransitions))
-                            : stripe::kWindowIndex[static_cast<std::size_t>(stripe::windowCode(
-                                  stripe::from(chain[static_cast<std::size_t>(j)]), window))];
-      if (index >= 0) {
-        found[static_cast<std::size_t>(count++)] =
-            static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
-      }
-    }
+  const auto vote = [&](std::size_t i, std::array<std::int16_t, stripe::kWindowTransitions>& found,
+                        int count) {
     const auto [best, bestVotes] =
         kReference ? mostFound(found, count) : majorityFound(found, count);
     // A level only on a strict majority of the pixel's windows.
@@ -372,6 +317,90 @@ void StripeDecoder::vote() {
       votes_[i] = static_cast<std::int16_t>(bestVotes);
       ++stats_.votedPixels;
     }
+  };
+  if constexpr (kReference) {
+    eachBoundary<true>([&](std::size_t i) {
+      own_[i] = 0;
+      votes_[i] = 0;
+      std::array<stripe::Transition, 2 * kChainEachWay + 1> chain{};
+      chain[kChainEachWay] = kindAt(i);
+      int lo = kChainEachWay;
+      for (std::size_t cur = i; lo > 0;) {
+        const std::int32_t link = prev_[cur];
+        if (link == kNone || !stepsBack(cur, indexOf(link))) {
+          break;
+        }
+        cur = indexOf(link);
+        chain[static_cast<std::size_t>(--lo)] = kindAt(cur);
+      }
+      int hi = kChainEachWay;
+      for (std::size_t cur = i; hi < 2 * kChainEachWay;) {
+        const std::int32_t link = next_[cur];
+        if (link == kNone || !stepsAhead(cur, indexOf(link))) {
+          break;
+        }
+        cur = indexOf(link);
+        chain[static_cast<std::size_t>(++hi)] = kindAt(cur);
+      }
+      // Windows start at j (chain index) with lo ≤ j, j + 5 ≤ hi, j ≤ kChainEachWay ≤ j + 5.
+      std::array<std::int16_t, stripe::kWindowTransitions> found{};
+      int count = 0;
+      for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
+        const int index =
+            stripe::decodeWindow(std::span<const stripe::Transition, stripe::kWindowTransitions>(
+                chain.data() + j, stripe::kWindowTransitions));
+        if (index >= 0) {
+          found[static_cast<std::size_t>(count++)] =
+              static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
+        }
+      }
+      vote(i, found, count);
+    });
+    return;
+  }
+  // The schedule decides each pixel's two steps once, not once per chain through it: bit 0 the
+  // step behind, bit 1 the step ahead, in candidate_ (free until step 3 sets it).
+  eachBoundary<false>([&](std::size_t i) {
+    const bool back = prev_[i] != kNone && stepsBack(i, indexOf(prev_[i]));
+    const bool ahead = next_[i] != kNone && stepsAhead(i, indexOf(next_[i]));
+    candidate_[i] = static_cast<std::int16_t>((back ? 1 : 0) | (ahead ? 2 : 0));
+  });
+  // The chain as two words instead of an array of transitions: bit k of `plus` set when chain[k]
+  // is a plus transition, bits 2k, 2k + 1 of `colours` its first colour. Each window's code is
+  // read from them: the links above chained the colours, so no window can fail decodeWindow's
+  // chain check.
+  eachBoundary<false>([&](std::size_t i) {
+    own_[i] = 0;
+    votes_[i] = 0;
+    unsigned plus = 0;
+    unsigned colours = 0;
+    const auto put = [&](std::size_t pixel, int k) {
+      plus |= kPlusOfCode[code_[pixel]] << static_cast<unsigned>(k);
+      colours |= kFromOfCode[code_[pixel]] << static_cast<unsigned>(2 * k);
+    };
+    put(i, kChainEachWay);
+    int lo = kChainEachWay;
+    for (std::size_t cur = i; lo > 0 && (candidate_[cur] & 1) != 0;) {
+      cur = indexOf(prev_[cur]);
+      put(cur, --lo);
+    }
+    int hi = kChainEachWay;
+    for (std::size_t cur = i; hi < 2 * kChainEachWay && (candidate_[cur] & 2) != 0;) {
+      cur = indexOf(next_[cur]);
+      put(cur, ++hi);
+    }
+    std::array<std::int16_t, stripe::kWindowTransitions> found{};
+    int count = 0;
+    for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
+      const unsigned window = (plus >> static_cast<unsigned>(j)) & kWindowMask;
+      const unsigned first = (colours >> static_cast<unsigned>(2 * j)) & 3U;
+      const int index = stripe::kWindowIndex[first * (kWindowMask + 1) + window];
+      if (index >= 0) {
+        found[static_cast<std::size_t>(count++)] =
+            static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
+      }
+    }
+    vote(i, found, count);
   });
 }
 
