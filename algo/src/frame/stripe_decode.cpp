@@ -214,22 +214,29 @@ void StripeDecoder::runSteps(ConstDirectionPlane d, StripePlane stripe) {
 // times), and the list of boundary pixels in ascending order.
 void StripeDecoder::prepare(ConstBoundaryPlane b, ConstDirectionPlane d) {
   const demux::UnitTable& units = units_[0];
-  for (int y = 0; y < height_; ++y) {
+  // Locals, not the members: the byte stores could alias them.
+  const int w = width_;
+  const int h = height_;
+  std::uint8_t* const code = code_.data();
+  Shift* const shift = shift_.data();
+  std::int32_t* const list = boundaries_.data();
+  std::int32_t count = 0;
+  for (int y = 0; y < h; ++y) {
     const Boundary* row = b.rowPtr(y);
     const std::uint16_t* dirs = d.rowPtr(y);
-    const auto base = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
-    for (int x = 0; x < width_; ++x) {
+    const auto base = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    for (int x = 0; x < w; ++x) {
       const std::size_t i = base + static_cast<std::size_t>(x);
-      code_[i] = row[x].transition;
+      code[i] = row[x].transition;
       if (row[x].present()) {
         const Unit u = unitOf(units, dirs[x]);
-        shift_[i] = {static_cast<std::int16_t>((row[x].offset * u.x + 8192) >> 14),
-                     static_cast<std::int16_t>((row[x].offset * u.y + 8192) >> 14)};
-        boundaries_[static_cast<std::size_t>(stats_.boundaryPixels++)] =
-            static_cast<std::int32_t>(i);
+        shift[i] = {static_cast<std::int16_t>((row[x].offset * u.x + 8192) >> 14),
+                    static_cast<std::int16_t>((row[x].offset * u.y + 8192) >> 14)};
+        list[count++] = static_cast<std::int32_t>(i);
       }
     }
   }
+  stats_.boundaryPixels = count;
 }
 
 // f(i) for every boundary pixel i, in ascending order: the reference looks at every pixel, the
@@ -433,21 +440,24 @@ void StripeDecoder::joinCurves() {
     candidate_[i] = 0;
   });
   if (params_.curves) {
-    const auto w = static_cast<std::size_t>(width_);
+    // Locals, not the members: the int32 stores of unite() could alias them.
+    const int width = width_;
+    const int height = height_;
+    const auto w = static_cast<std::size_t>(width);
     eachBoundary<kReference>([&](std::size_t at) {
       const int x = static_cast<int>(at % w);
       const int y = static_cast<int>(at / w);
       const auto i = static_cast<std::int32_t>(at);
       const std::uint8_t t = code_[at];
-      if (x + 1 < width_ && code_[flat(x + 1, y, width_)] == t) {
+      if (x + 1 < width && code_[flat(x + 1, y, width)] == t) {
         unite(i, i + 1);
       }
-      if (y + 1 == height_) {
+      if (y + 1 == height) {
         return;
       }
       for (int dx = -1; dx <= 1; ++dx) {
-        if (x + dx >= 0 && x + dx < width_ && code_[flat(x + dx, y + 1, width_)] == t) {
-          unite(i, i + width_ + dx);
+        if (x + dx >= 0 && x + dx < width && code_[flat(x + dx, y + 1, width)] == t) {
+          unite(i, i + width + dx);
         }
       }
     });
@@ -620,11 +630,14 @@ void StripeDecoder::smoothPositions(ConstDirectionPlane d) {
 // gives more coordinates but more wrong ones (docs/decode.md).
 void StripeDecoder::fill(ConstDirectionPlane d, StripePlane stripe) {
   int rowPixels = 0;
-  for (int y = 0; y < height_; ++y) {
+  // Locals, not the members: the byte stores below could alias them.
+  const int w = width_;
+  const int h = height_;
+  for (int y = 0; y < h; ++y) {
     StripeQ16* out = stripe.rowPtr(y);
     const std::uint16_t* dirs = d.rowPtr(y);
-    std::uint8_t* axis = &axis_[flat(0, y, width_)];
-    for (int x = 0; x < width_; ++x) {
+    std::uint8_t* axis = &axis_[flat(0, y, w)];
+    for (int x = 0; x < w; ++x) {
       out[x] = kNoStripe;
       // Within 45° of ±x: the angle (2^16 a turn) plus an eighth turn, modulo a half turn, lies
       // in the first quarter turn.
