@@ -283,6 +283,18 @@ Result<Triangulator> triangulatorFor(const TriangulationTables& tables,
 
 constexpr double kNominalM = 0.9;
 
+// The triangulator of the rig's one pair, fitted at kNominalM, in `memory`.
+std::optional<Triangulator> pairTriangulator(const Rig& rig, std::vector<std::byte>& memory) {
+  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
+  EXPECT_TRUE(tables) << (tables ? "" : tables.error());
+  if (!tables) {
+    return std::nullopt;
+  }
+  auto t = triangulatorFor(*tables, memory);
+  EXPECT_TRUE(t);
+  return t ? std::optional<Triangulator>(*t) : std::nullopt;
+}
+
 // Given a projector with a realistic lens (barrel, a little tangential), when exact stripe
 // coordinates of points on pixel rays (lens::project, the simulator's own model) are
 // triangulated, then every depth within the working range (0.45–1.8 m) is within 0.1 mm of the
@@ -326,10 +338,8 @@ TEST(DistortedProjector, ExactStripeGivesTheDepthWithinATenthOfAMillimetre) {
 TEST(DistortedProjector, RunMatchesDepthAtWithoutTouchingTheHeap) {
   Rig rig = makeRig();
   rig.projectors[0].dist = {0.04, 0.0, 0.0, 0.0, 0.0};
-  const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
-  ASSERT_TRUE(tables) << tables.error();
   std::vector<std::byte> memory;
-  const auto t = triangulatorFor(*tables, memory);
+  const auto t = pairTriangulator(rig, memory);
   ASSERT_TRUE(t);
   const int w = rig.cameras[0].width;
   const int h = rig.cameras[0].height;
@@ -374,10 +384,8 @@ TEST(TriangulationWithTrust, OnePassGivesTheReferenceOnRandomStripes) {
     if (distorted) {
       rig.projectors[0].dist = {-0.05, 0.01, 0.001, -0.0005, 0.0};
     }
-    const auto tables = buildTriangulationTables(rig, 0, 0, kDefaultDepthUnitM, kNominalM);
-    ASSERT_TRUE(tables) << tables.error();
     std::vector<std::byte> memory;
-    const auto t = triangulatorFor(*tables, memory);
+    const auto t = pairTriangulator(rig, memory);
     ASSERT_TRUE(t);
     const int w = rig.cameras[0].width;
     const int h = rig.cameras[0].height;

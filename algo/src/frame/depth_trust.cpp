@@ -1,8 +1,11 @@
 // Per-pair trust: resolvability and predicted depth error from the stripe gradient
-// (depth_trust.hpp). This scalar code is the reference; no separate schedule exists.
+// (depth_trust.hpp). This scalar code is the reference; its schedule, with the triangulation in
+// the same pass, is triangulateTrusted() (depth_trust_schedule.cpp).
 #include "smx/algo/depth_trust.hpp"
 
 #include <cstdint>
+
+#include "trust/trust_arguments.hpp"
 
 namespace smx::algo {
 
@@ -60,17 +63,25 @@ Result<void> validateDepthTrust(const DepthTrustParams& p) {
   return {};
 }
 
-Result<void> trustDepth(const Triangulator& triangulator, ConstStripePlane stripe, DepthPlane depth,
-                        ImageView<std::uint8_t> confidence, const DepthTrustParams& params) {
+Result<void> checkTrustArguments(const Triangulator& triangulator, ConstStripePlane stripe,
+                                 DepthPlane depth, ImageView<std::uint8_t> confidence,
+                                 const DepthTrustParams& params) {
   const int w = triangulator.width();
   const int h = triangulator.height();
   if (stripe.width() != w || stripe.height() != h || depth.width() != w || depth.height() != h ||
       confidence.width() != w || confidence.height() != h) {
     return fail(Errc::kSizeMismatch, "trust: planes must match the triangulation tables");
   }
-  if (auto ok = validateDepthTrust(params); !ok) {
+  return validateDepthTrust(params);
+}
+
+Result<void> trustDepth(const Triangulator& triangulator, ConstStripePlane stripe, DepthPlane depth,
+                        ImageView<std::uint8_t> confidence, const DepthTrustParams& params) {
+  if (auto ok = checkTrustArguments(triangulator, stripe, depth, confidence, params); !ok) {
     return ok;
   }
+  const int w = triangulator.width();
+  const int h = triangulator.height();
   for (int y = 0; y < h; ++y) {
     const StripeQ16* row = stripe.rowPtr(y);
     const StripeQ16* up = y > 0 ? stripe.rowPtr(y - 1) : nullptr;

@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "smx/algo/depth_trust.hpp"
+#include "trust/trust_arguments.hpp"
 
 namespace smx::algo {
 
@@ -157,13 +158,7 @@ void trustRows(const Triangulator::Lookup t, ConstStripePlane stripe, DepthPlane
 Result<void> triangulateTrusted(const Triangulator& triangulator, ConstStripePlane stripe,
                                 DepthPlane depth, ImageView<std::uint8_t> confidence,
                                 const DepthTrustParams& params) {
-  const int w = triangulator.width();
-  const int h = triangulator.height();
-  if (stripe.width() != w || stripe.height() != h || depth.width() != w || depth.height() != h ||
-      confidence.width() != w || confidence.height() != h) {
-    return fail(Errc::kSizeMismatch, "trust: planes must match the triangulation tables");
-  }
-  if (auto ok = validateDepthTrust(params); !ok) {
+  if (auto ok = checkTrustArguments(triangulator, stripe, depth, confidence, params); !ok) {
     return ok;
   }
   const Triangulator::Lookup lookup = triangulator.lookup();

@@ -1,6 +1,7 @@
 // Triangulation per frame (triangulation.hpp; paper §4.2: range from the decoded stripe
 // coordinate and the calibration): the tables copied into the arena at create(), one integer
-// division per pixel. This scalar code is the reference; no separate schedule exists.
+// division per pixel. This scalar code is the reference; the pipeline runs it together with the
+// trust filter as triangulateTrusted() (depth_trust_schedule.cpp).
 #include <cstdint>
 
 #include "smx/algo/triangulation.hpp"
