@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "trust/trust_arguments.hpp"
+#include "trust/trust_shared.hpp"
 
 namespace smx::algo {
 
@@ -29,17 +29,6 @@ bool axisDerivative(StripeQ16 a, StripeQ16 c, StripeQ16 b, std::int64_t& d) {
   }
   d = d < 0 ? -d : d;
   return true;
-}
-
-// The confidence of a depth with predicted error spread / 2, or 0 when it is not trusted.
-std::uint8_t confidenceOf(std::int64_t spread, std::int32_t z, const DepthTrustParams& p) {
-  const std::int64_t tol2 = 2 * std::int64_t{p.tolerance.at(z)};
-  const std::int64_t scaled = spread * p.errorMargin;
-  if (scaled > tol2) {
-    return 0;
-  }
-  const std::int64_t c = 255 - (255 * scaled) / tol2;
-  return static_cast<std::uint8_t>(c < 1 ? 1 : c);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 #include <limits>
 
 #include "smx/algo/depth_trust.hpp"
-#include "trust/trust_arguments.hpp"
+#include "trust/trust_shared.hpp"
 
 namespace smx::algo {
 
@@ -60,9 +60,7 @@ void gradients(const StripeQ16* row, const StripeQ16* up, const StripeQ16* down,
 
 struct Limits {
   std::uint32_t maxGradient = 0;  // the largest |∇s| whose stripes are resolvable
-  std::int64_t boundaryErrorQ8 = 0;
-  std::int64_t errorMargin = 0;
-  DepthTolerance tolerance;
+  DepthTrustParams params;
 };
 
 Limits limitsOf(const DepthTrustParams& p) {
@@ -70,7 +68,7 @@ Limits limitsOf(const DepthTrustParams& p) {
   constexpr std::uint32_t kOneOverPxQ24 = 1U << 24U;
   return {p.minStripeWidthQ8 > 0 ? kOneOverPxQ24 / static_cast<std::uint32_t>(p.minStripeWidthQ8)
                                  : kNoGradient - 1,
-          p.boundaryErrorQ8, p.errorMargin, p.tolerance};
+          p};
 }
 
 struct Trusted {
@@ -88,7 +86,7 @@ Trusted trusted(const Triangulator::Lookup& t, std::size_t i, std::int32_t s,
   if (z == kNoDepth) {
     return kNone;
   }
-  const std::int64_t ahead = s + ((std::int64_t{gradient} * l.boundaryErrorQ8 + 128) >> 8);
+  const std::int64_t ahead = s + ((std::int64_t{gradient} * l.params.boundaryErrorQ8 + 128) >> 8);
   if (ahead >= Triangulator::kMaxStripe) {
     return kNone;
   }
@@ -97,13 +95,8 @@ Trusted trusted(const Triangulator::Lookup& t, std::size_t i, std::int32_t s,
     return kNone;
   }
   const std::int64_t spread = std::int64_t{2} * (zAhead > z ? zAhead - z : z - zAhead);
-  const std::int64_t tol2 = 2 * std::int64_t{l.tolerance.at(z)};
-  const std::int64_t scaled = spread * l.errorMargin;
-  if (scaled > tol2) {
-    return kNone;
-  }
-  const std::int64_t c = 255 - (255 * scaled) / tol2;
-  return {z, static_cast<std::uint8_t>(c < 1 ? 1 : c)};
+  const std::uint8_t c = confidenceOf(spread, z, l.params);
+  return c == 0 ? kNone : Trusted{z, c};
 }
 
 constexpr std::array<StripeQ16, kChunk + 2> kNoRow = [] {

@@ -95,7 +95,6 @@ constexpr std::array<unsigned, stripe::kTransitions + 1> kFromOfCode = [] {
   return table;
 }();
 constexpr unsigned kWindowMask = (1U << stripe::kWindowTransitions) - 1;
-static_assert(stripe::windowCode(stripe::Colour::kBlue, 5) == 2 * (kWindowMask + 1) + 5);
 
 Result<void> validate(int width, int height, const DecodeParams& p) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192) {
@@ -401,7 +400,8 @@ void StripeDecoder::vote() {
     for (int j = lo; j <= kChainEachWay && j + stripe::kWindowTransitions - 1 <= hi; ++j) {
       const unsigned window = (plus >> static_cast<unsigned>(j)) & kWindowMask;
       const unsigned first = (colours >> static_cast<unsigned>(2 * j)) & 3U;
-      const int index = stripe::kWindowIndex[first * (kWindowMask + 1) + window];
+      const int index = stripe::kWindowIndex[static_cast<std::size_t>(
+          stripe::windowCode(static_cast<stripe::Colour>(first), static_cast<int>(window)))];
       if (index >= 0) {
         found[static_cast<std::size_t>(count++)] =
             static_cast<std::int16_t>(index + (kChainEachWay - j) + 1);
