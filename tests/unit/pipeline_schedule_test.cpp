@@ -262,6 +262,8 @@ TEST(PipelineSchedule, LanesBeyondTheProjectorsAreRefused) {
 // ranges with noise, holes, outliers and values on a quantised grid (equal variances: unions),
 // and the filter's jumps; the image sizes leave no border unvisited. Dense ranges on a wide
 // image give full windows (taken whole, in unions too) across the schedule's chunks of columns.
+// Noise as wide as the tolerance, at and past the span within which the schedule's 32-bit window
+// spreads are exact, gives spreads past 2^32 where it must not compare them.
 TEST(PipelineSchedule, MergeAndEdgeFilterGiveTheReferenceOnRandomRanges) {
   std::mt19937 rng(7);
   struct Holes {
@@ -270,69 +272,118 @@ TEST(PipelineSchedule, MergeAndEdgeFilterGiveTheReferenceOnRandomRanges) {
     int outlierPct;
     bool blankBands;  // each range without values in bands of columns, the bands shifted per range
   };
-  for (const Holes holes :
-       {Holes{37, 20, 10, false}, Holes{150, 2, 2, false}, Holes{150, 2, 2, true}}) {
-    for (const int ranges : {1, 2, 3, 5, 8}) {
-      for (const int quantum : {1, 8, 64}) {
-        SCOPED_TRACE(std::to_string(ranges) + " ranges, quantum " + std::to_string(quantum) +
-                     ", width " + std::to_string(holes.width) +
-                     (holes.blankBands ? ", blank bands" : ""));
-        const int w = holes.width;
-        const int h = 23;
-        const auto pixels = static_cast<std::size_t>(w * h);
-        std::vector<std::vector<std::uint16_t>> depth(static_cast<std::size_t>(ranges));
-        std::vector<std::vector<std::uint8_t>> confidence(static_cast<std::size_t>(ranges));
-        std::vector<ConstDepthPlane> views;
-        std::vector<ImageView<const std::uint8_t>> confidenceViews;
-        std::uniform_int_distribution<int> noise(-20, 20);
-        std::uniform_int_distribution<int> percent(0, 99);
-        for (std::size_t r = 0; r < depth.size(); ++r) {
-          depth[r].resize(pixels);
-          confidence[r].resize(pixels);
-          for (std::size_t i = 0; i < pixels; ++i) {
-            const int x = static_cast<int>(i) % w;
-            const int roll = percent(rng);
-            int z = 9000 + 15 * x + noise(rng);
-            z = z / quantum * quantum;
-            if (roll < holes.missingPct ||
-                (holes.blankBands && (x / 6 + static_cast<int>(r)) % 3 == 0)) {
-              z = kNoDepth;
-            } else if (roll < holes.missingPct + holes.outlierPct) {
-              z = 6000 + 40 * noise(rng);  // an outlier or another surface
+  struct Values {
+    int base;
+    int noise;  // ± this, uniform
+    DepthTolerance tolerance;
+  };
+  for (const Values values : {Values{9000, 20, {50, 10}}, Values{30000, 7300, {7327, 0}},
+                              Values{30000, 10000, {7328, 0}}, Values{30000, 10000, {10000, 0}}}) {
+    for (const Holes holes :
+         {Holes{37, 20, 10, false}, Holes{150, 2, 2, false}, Holes{150, 2, 2, true}}) {
+      for (const int ranges : {1, 2, 3, 5, 8}) {
+        for (const int quantum : {1, 8, 64}) {
+          SCOPED_TRACE("noise ±" + std::to_string(values.noise) + ", tolerance " +
+                       std::to_string(values.tolerance.minUnits) + ", " + std::to_string(ranges) +
+                       " ranges, quantum " + std::to_string(quantum) + ", width " +
+                       std::to_string(holes.width) + (holes.blankBands ? ", blank bands" : ""));
+          const int w = holes.width;
+          const int h = 23;
+          const auto pixels = static_cast<std::size_t>(w * h);
+          std::vector<std::vector<std::uint16_t>> depth(static_cast<std::size_t>(ranges));
+          std::vector<std::vector<std::uint8_t>> confidence(static_cast<std::size_t>(ranges));
+          std::vector<ConstDepthPlane> views;
+          std::vector<ImageView<const std::uint8_t>> confidenceViews;
+          std::uniform_int_distribution<int> noise(-values.noise, values.noise);
+          std::uniform_int_distribution<int> outlier(-800, 800);
+          std::uniform_int_distribution<int> percent(0, 99);
+          for (std::size_t r = 0; r < depth.size(); ++r) {
+            depth[r].resize(pixels);
+            confidence[r].resize(pixels);
+            for (std::size_t i = 0; i < pixels; ++i) {
+              const int x = static_cast<int>(i) % w;
+              const int roll = percent(rng);
+              int z = values.base + 15 * x + noise(rng);
+              z = z / quantum * quantum;
+              if (roll < holes.missingPct ||
+                  (holes.blankBands && (x / 6 + static_cast<int>(r)) % 3 == 0)) {
+                z = kNoDepth;
+              } else if (roll < holes.missingPct + holes.outlierPct) {
+                z = values.base / 2 + outlier(rng);  // an outlier or another surface
+              }
+              depth[r][i] = static_cast<std::uint16_t>(z);
+              confidence[r][i] =
+                  static_cast<std::uint8_t>(z == kNoDepth ? 0 : 1 + percent(rng) * 2);
             }
-            depth[r][i] = static_cast<std::uint16_t>(z);
-            confidence[r][i] = static_cast<std::uint8_t>(z == kNoDepth ? 0 : 1 + percent(rng) * 2);
+            views.push_back(*ConstDepthPlane::packed(depth[r], w, h));
+            confidenceViews.push_back(*ImageView<const std::uint8_t>::packed(confidence[r], w, h));
           }
-          views.push_back(*ConstDepthPlane::packed(depth[r], w, h));
-          confidenceViews.push_back(*ImageView<const std::uint8_t>::packed(confidence[r], w, h));
-        }
-        std::vector<std::uint16_t> merged(pixels);
-        std::vector<std::uint16_t> mergedReference(pixels);
-        std::vector<std::uint8_t> mergedConfidence(pixels);
-        std::vector<std::uint8_t> mergedConfidenceReference(pixels);
-        const DepthTolerance tolerance{50, 10};
-        ASSERT_TRUE(mergeRanges(views, confidenceViews, *DepthPlane::packed(merged, w, h),
-                                *ImageView<std::uint8_t>::packed(mergedConfidence, w, h),
-                                tolerance));
-        ASSERT_TRUE(mergeRangesReference(
-            views, confidenceViews, *DepthPlane::packed(mergedReference, w, h),
-            *ImageView<std::uint8_t>::packed(mergedConfidenceReference, w, h), tolerance));
-        EXPECT_EQ(merged, mergedReference);
-        EXPECT_EQ(mergedConfidence, mergedConfidenceReference);
-        EXPECT_GT(std::count_if(merged.begin(), merged.end(),
-                                [](std::uint16_t z) { return z != kNoDepth; }),
-                  static_cast<std::ptrdiff_t>(pixels / 4));
+          std::vector<std::uint16_t> merged(pixels);
+          std::vector<std::uint16_t> mergedReference(pixels);
+          std::vector<std::uint8_t> mergedConfidence(pixels);
+          std::vector<std::uint8_t> mergedConfidenceReference(pixels);
+          const DepthTolerance tolerance = values.tolerance;
+          ASSERT_TRUE(mergeRanges(views, confidenceViews, *DepthPlane::packed(merged, w, h),
+                                  *ImageView<std::uint8_t>::packed(mergedConfidence, w, h),
+                                  tolerance));
+          ASSERT_TRUE(mergeRangesReference(
+              views, confidenceViews, *DepthPlane::packed(mergedReference, w, h),
+              *ImageView<std::uint8_t>::packed(mergedConfidenceReference, w, h), tolerance));
+          EXPECT_EQ(merged, mergedReference);
+          EXPECT_EQ(mergedConfidence, mergedConfidenceReference);
+          EXPECT_GT(std::count_if(merged.begin(), merged.end(),
+                                  [](std::uint16_t z) { return z != kNoDepth; }),
+                    static_cast<std::ptrdiff_t>(pixels / 4));
 
-        for (const int permille : {0, 5, 20, 1000}) {
-          std::vector<std::uint16_t> kept(pixels);
-          std::vector<std::uint16_t> keptReference(pixels);
-          ASSERT_TRUE(removeDepthEdges(views[0], *DepthPlane::packed(kept, w, h), permille));
-          ASSERT_TRUE(removeDepthEdgesReference(views[0], *DepthPlane::packed(keptReference, w, h),
-                                                permille));
-          EXPECT_EQ(kept, keptReference) << permille << " per mille";
+          for (const int permille : {0, 5, 20, 1000}) {
+            std::vector<std::uint16_t> kept(pixels);
+            std::vector<std::uint16_t> keptReference(pixels);
+            ASSERT_TRUE(removeDepthEdges(views[0], *DepthPlane::packed(kept, w, h), permille));
+            ASSERT_TRUE(removeDepthEdgesReference(
+                views[0], *DepthPlane::packed(keptReference, w, h), permille));
+            EXPECT_EQ(kept, keptReference) << permille << " per mille";
+          }
         }
       }
     }
+  }
+}
+
+// The schedule orders full windows by 9·Σz² − (Σz)² in 32-bit arithmetic, exact while a window's
+// values span at most 14654 (20·14654² < 2^32). Two full windows at one pixel: the first range's
+// narrow, the second's four values at the tolerance's low end and five at its high end, so its
+// spread is the largest nine values in that span can have. Past the limit that spread wraps to
+// less than the narrow window's, and a schedule that compared it would take the wide window.
+TEST(PipelineSchedule, MergeNeverComparesWrappedSpreads) {
+  constexpr std::uint16_t kRef = 30000;
+  for (const int tolerance : {7327, 7328, 9000}) {
+    SCOPED_TRACE("tolerance " + std::to_string(tolerance));
+    constexpr int kSide = 3;  // one inner pixel
+    std::vector<std::uint16_t> narrow(kSide * kSide);
+    std::vector<std::uint16_t> wide(kSide * kSide);
+    for (std::size_t i = 0; i < narrow.size(); ++i) {
+      narrow[i] = i == 4 ? kRef : static_cast<std::uint16_t>(i % 2 == 0 ? kRef - 200 : kRef + 200);
+      wide[i] = static_cast<std::uint16_t>(i < 4 ? kRef - tolerance : kRef + tolerance);
+    }
+    const std::vector<ConstDepthPlane> ranges{*ConstDepthPlane::packed(narrow, kSide, kSide),
+                                              *ConstDepthPlane::packed(wide, kSide, kSide)};
+    std::vector<std::uint8_t> full(narrow.size(), 200);
+    const std::vector<ImageView<const std::uint8_t>> confidences{
+        *ImageView<const std::uint8_t>::packed(full, kSide, kSide),
+        *ImageView<const std::uint8_t>::packed(full, kSide, kSide)};
+    std::vector<std::uint16_t> merged(narrow.size());
+    std::vector<std::uint16_t> mergedReference(narrow.size());
+    std::vector<std::uint8_t> confidence(narrow.size());
+    std::vector<std::uint8_t> confidenceReference(narrow.size());
+    const DepthTolerance within{tolerance, 0};
+    ASSERT_TRUE(mergeRanges(ranges, confidences, *DepthPlane::packed(merged, kSide, kSide),
+                            *ImageView<std::uint8_t>::packed(confidence, kSide, kSide), within));
+    ASSERT_TRUE(mergeRangesReference(
+        ranges, confidences, *DepthPlane::packed(mergedReference, kSide, kSide),
+        *ImageView<std::uint8_t>::packed(confidenceReference, kSide, kSide), within));
+    EXPECT_EQ(mergedReference[4], kRef) << "the narrow window has the smaller variance";
+    EXPECT_EQ(merged, mergedReference);
+    EXPECT_EQ(confidence, confidenceReference);
   }
 }
 

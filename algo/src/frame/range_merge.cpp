@@ -3,14 +3,16 @@
 // merge<false> the schedule: the same sets and median, reached with fewer steps (pixels without
 // depth passed over; each chunk of a row's 3 × 3 windows, their extremes, sums, variance and
 // median, formed in vector lanes from 3 × 1 columns computed once for the three windows that
-// hold them; a pixel whose windows are each empty or full and agreeing decided from those
-// alone; otherwise sets gathered in place and the median by selection instead of sorting).
+// hold them; pixels whose windows are each empty or full and agreeing decided from those alone,
+// a chunk at a time in vector lanes; otherwise sets gathered in place and the median by
+// selection instead of sorting).
 #include "smx/algo/range_merge.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace smx::algo {
 
@@ -72,16 +74,18 @@ std::uint16_t medianBySelection(std::array<std::uint16_t, kMaxValues>& v, std::s
 
 // The schedule's 3 × 3 windows of one range along one chunk of a row, each from the three 3 × 1
 // columns it holds (every column computed once for the three windows): extremes, the median of
-// nine, the sums and 9·Σz² − (Σz)², which orders two full windows' variances as
-// compareVariance() does (equal counts: its n² factors cancel).
+// nine, the sum and 9·Σz² − (Σz)², which orders two full windows' variances as compareVariance()
+// does (equal counts: its n² factors cancel). That spread is Σ over pairs of (z_i − z_j)², at
+// most 20·(hi − lo)² for nine values, so in uint32 arithmetic (modulo 2^32) it is exact wherever
+// hi − lo ≤ kMaxExactSpan; only windows within such a span are ever compared by it.
 constexpr int kChunk = 64;
+constexpr std::uint32_t kMaxExactSpan = 14654;  // 20 · 14654² < 2^32 ≤ 20 · 14655²
 struct ChunkWindows {
   std::array<std::uint16_t, kChunk> lo;
   std::array<std::uint16_t, kChunk> hi;
   std::array<std::uint16_t, kChunk> median;
   std::array<std::int32_t, kChunk> sum;
-  std::array<std::int64_t, kChunk> squares;
-  std::array<std::int64_t, kChunk> spread;
+  std::array<std::uint32_t, kChunk> spread;
 };
 
 std::int32_t medianOfThree(std::int32_t a, std::int32_t b, std::int32_t c) {
@@ -98,7 +102,7 @@ void fillWindows(const ConstDepthPlane& r, int y, int cx, int xBegin, int xEnd,
   std::array<std::int32_t, kColumns> mid{};
   std::array<std::int32_t, kColumns> hi{};
   std::array<std::int32_t, kColumns> sum{};
-  std::array<std::int64_t, kColumns> squares{};
+  std::array<std::uint32_t, kColumns> squares{};  // modulo 2^32
   const std::uint16_t* above = r.rowPtr(y - 1) + xBegin - 1;
   const std::uint16_t* at = r.rowPtr(y) + xBegin - 1;
   const std::uint16_t* below = r.rowPtr(y + 1) + xBegin - 1;
@@ -111,7 +115,10 @@ void fillWindows(const ConstDepthPlane& r, int y, int cx, int xBegin, int xEnd,
     hi[c] = std::max(std::max(a, b), d);
     sum[c] = a + b + d;
     mid[c] = sum[c] - lo[c] - hi[c];
-    squares[c] = std::int64_t{a} * a + std::int64_t{b} * b + std::int64_t{d} * d;
+    const auto ua = static_cast<std::uint32_t>(a);
+    const auto ub = static_cast<std::uint32_t>(b);
+    const auto ud = static_cast<std::uint32_t>(d);
+    squares[c] = ua * ua + ub * ub + ud * ud;
   }
   const auto first = static_cast<std::size_t>(xBegin - cx);
   for (std::size_t c = 0; c + 2 < columns; ++c) {
@@ -127,13 +134,13 @@ void fillWindows(const ConstDepthPlane& r, int y, int cx, int xBegin, int xEnd,
     const std::int32_t highs = std::min(std::min(hi0, hi1), hi2);
     const std::int32_t mids = medianOfThree(mid[c], mid[c + 1], mid[c + 2]);
     const std::int32_t s = sum[c] + sum[c + 1] + sum[c + 2];
-    const std::int64_t q = squares[c] + squares[c + 1] + squares[c + 2];
+    const std::uint32_t q = squares[c] + squares[c + 1] + squares[c + 2];
+    const auto us = static_cast<std::uint32_t>(s);
     windows.lo[k] = static_cast<std::uint16_t>(std::min(std::min(lo0, lo1), lo2));
     windows.hi[k] = static_cast<std::uint16_t>(std::max(std::max(hi0, hi1), hi2));
     windows.median[k] = static_cast<std::uint16_t>(medianOfThree(lows, mids, highs));
     windows.sum[k] = s;
-    windows.squares[k] = q;
-    windows.spread[k] = kWindow * q - std::int64_t{s} * s;
+    windows.spread[k] = kWindow * q - us * us;
   }
 }
 
@@ -143,13 +150,14 @@ bool agreesThroughout(const ChunkWindows& windows, std::size_t k, std::int32_t l
   return windows.lo[k] >= low && static_cast<std::uint32_t>(windows.hi[k] - low) <= span;
 }
 
-// Window k as a set when it agrees throughout; false otherwise.
+// Window k as a set when it agrees throughout and its spread is exact; false otherwise.
 bool fullWindow(const ChunkWindows& windows, std::size_t k, std::int32_t low, std::uint32_t span,
                 Set& set) {
-  if (!agreesThroughout(windows, k, low, span)) {
+  if (span > kMaxExactSpan || !agreesThroughout(windows, k, low, span)) {
     return false;
   }
-  set = {kWindow, windows.sum[k], windows.squares[k]};
+  const std::int64_t sum = windows.sum[k];
+  set = {kWindow, sum, (std::int64_t{windows.spread[k]} + sum * sum) / kWindow};
   return true;
 }
 
@@ -228,6 +236,9 @@ struct ConfidenceAt {
 // window's. False, with nothing written, where the fold would do anything else.
 bool mergeFullWindows(std::span<const ChunkWindows> windows, std::size_t k, std::int32_t low,
                       std::uint32_t span, std::uint16_t& out, const ConfidenceAt& confidence) {
+  if (span > kMaxExactSpan) {
+    return false;
+  }
   const ChunkWindows* best = nullptr;
   std::int32_t error = 255;
   int agreeing = 0;
@@ -258,6 +269,131 @@ bool mergeFullWindows(std::span<const ChunkWindows> windows, std::size_t k, std:
     *confidence.out = mergedConfidence(error, agreeing);
   }
   return true;
+}
+
+// mergeFullWindows() for every inner pixel [xBegin, xEnd) of a chunk at once, in vector lanes
+// (index x − cx): where no range has a value at the pixel, or where every range's window is
+// empty or agrees throughout with the first range's value (so every value at the pixel does:
+// the vote's reference is that first value) without a tie, the pixel's output and confidence
+// are written and its `decided` lane set. The rest is left to the per-pixel path.
+struct ChunkDecision {
+  std::array<std::int32_t, kChunk> first;
+  std::array<std::int32_t, kChunk> low;
+  std::array<std::uint32_t, kChunk> span;
+  std::array<std::int32_t, kChunk> open;  // no window disagrees, no tie yet
+  std::array<std::uint32_t, kChunk> spread;
+  std::array<std::int32_t, kChunk> median;
+  std::array<std::int32_t, kChunk> error;
+  std::array<std::int32_t, kChunk> agreeing;
+  std::array<std::int32_t, kChunk> inverse;  // kInverseSqrtQ8[agreeing]
+  std::array<std::uint8_t, kChunk> decided;
+};
+
+struct ChunkInputs {
+  std::span<const ChunkWindows> windows;
+  std::span<const std::uint16_t* const> centreRows;
+  std::span<const std::uint8_t* const> confidenceRows;  // empty: no confidence output
+  int cx = 0;
+  int xBegin = 0;
+  int xEnd = 0;
+};
+
+void decideChunk(const ChunkInputs& in, const DepthTolerance& tolerance, std::uint16_t* out,
+                 std::uint8_t* outConfidence, ChunkDecision& d) {
+  const auto kBegin = static_cast<std::size_t>(in.xBegin - in.cx);
+  const auto kEnd = static_cast<std::size_t>(in.xEnd - in.cx);
+  const auto cx = static_cast<std::size_t>(in.cx);
+  for (std::size_t k = kBegin; k < kEnd; ++k) {
+    d.first[k] = 0;
+  }
+  for (const std::uint16_t* centre : in.centreRows) {
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      const std::int32_t f = d.first[k];
+      const std::int32_t z = centre[cx + k];  // loaded either way: no branch
+      d.first[k] = f != 0 ? f : z;
+    }
+  }
+  const auto permille = static_cast<std::uint32_t>(tolerance.permille);
+  const std::int32_t minUnits = tolerance.minUnits;
+  for (std::size_t k = kBegin; k < kEnd; ++k) {
+    // DepthTolerance::at(), unsigned (the same for z ≥ 0): the division vectorises.
+    const std::int32_t f = d.first[k];
+    const auto relative =
+        static_cast<std::int32_t>(static_cast<std::uint32_t>(f) * permille / 1000);
+    const std::int32_t tol = relative > minUnits ? relative : minUnits;
+    const std::int32_t low = f > tol ? f - tol : 1;
+    const auto span = static_cast<std::uint32_t>(f + tol - low);
+    d.low[k] = low;
+    d.span[k] = span;
+    d.open[k] = span <= kMaxExactSpan ? 1 : 0;
+    d.spread[k] = 0xffffffffU;
+    d.median[k] = 0;
+    d.error[k] = 255;
+    d.agreeing[k] = 0;
+  }
+  for (std::size_t i = 0; i < in.windows.size(); ++i) {
+    const ChunkWindows& w = in.windows[i];
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      const std::int32_t lo = w.lo[k];
+      const std::int32_t hi = w.hi[k];
+      const std::int32_t low = d.low[k];
+      const std::uint32_t span = d.span[k];
+      const std::uint32_t spread = w.spread[k];
+      const std::uint32_t best = d.spread[k];
+      const std::int32_t median = w.median[k];
+      const std::int32_t bestMedian = d.median[k];
+      // Bitwise, not short-circuit operators: every lane computes everything.
+      const std::int32_t full = hi != kNoDepth ? 1 : 0;
+      const std::int32_t agrees =
+          (lo >= low ? 1 : 0) & (static_cast<std::uint32_t>(hi - low) <= span ? 1 : 0);
+      const std::int32_t smaller = full & (spread < best ? 1 : 0);
+      const std::int32_t tie = full & (spread == best ? 1 : 0);
+      d.open[k] &= (agrees | (full ^ 1)) & (tie ^ 1);
+      // Selects as arithmetic (an empty window's spread as the largest): GCC if-converts these.
+      d.spread[k] = std::min(best, spread | static_cast<std::uint32_t>(full - 1));
+      d.median[k] = (median & -smaller) | (bestMedian & (smaller - 1));
+      d.agreeing[k] += full;
+    }
+    if (!in.confidenceRows.empty()) {
+      const std::uint8_t* confidence = in.confidenceRows[i] + cx;
+      for (std::size_t k = kBegin; k < kEnd; ++k) {
+        // An empty window's error as 256 or more: it never counts.
+        const std::int32_t empty = w.hi[k] == kNoDepth ? 1 : 0;
+        const std::int32_t e = 255 - std::int32_t{confidence[k]} + (empty << 8);
+        d.error[k] = std::min(d.error[k], e);
+      }
+    }
+  }
+  for (std::size_t k = kBegin; k < kEnd; ++k) {
+    const std::int32_t depth = d.first[k] != kNoDepth ? 1 : 0;
+    d.decided[k] = static_cast<std::uint8_t>((depth ^ 1) | d.open[k]);
+    out[cx + k] = static_cast<std::uint16_t>(d.median[k] & -depth);
+  }
+  if (outConfidence != nullptr) {
+    // kInverseSqrtQ8[agreeing] without a gather: one pass per possible count.
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      d.inverse[k] = 0;
+    }
+    for (std::size_t a = 1; a <= in.windows.size(); ++a) {
+      const std::int32_t inverse = kInverseSqrtQ8[a];
+      const auto count = static_cast<std::int32_t>(a);
+      for (std::size_t k = kBegin; k < kEnd; ++k) {
+        d.inverse[k] |= inverse & -(d.agreeing[k] == count ? 1 : 0);
+      }
+    }
+    for (std::size_t k = kBegin; k < kEnd; ++k) {
+      const std::int32_t e = std::min((d.error[k] * d.inverse[k] + 128) >> 8, 254);
+      const std::int32_t depth = d.first[k] != kNoDepth ? 1 : 0;
+      outConfidence[cx + k] = static_cast<std::uint8_t>((255 - e) & -depth);
+    }
+  }
+}
+
+// Whether decideChunk() decided lanes k … k + 7.
+bool allDecided8(const ChunkDecision& d, std::size_t k) {
+  std::uint64_t lanes = 0;
+  std::memcpy(&lanes, &d.decided[k], sizeof lanes);
+  return lanes == 0x0101010101010101U;
 }
 
 template <bool kReference>
@@ -300,6 +436,7 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
   std::array<std::uint16_t, kWindow> next{};
   std::array<std::uint16_t, kMaxRanges> centre{};
   std::array<ChunkWindows, kMaxRanges> windows{};
+  ChunkDecision decision{};
   std::array<const std::uint16_t*, kMaxRanges> centreRows{};
   std::array<const std::uint8_t*, kMaxRanges> confidenceRows{};
   const int yEnd = rows.end < h ? rows.end : h;
@@ -321,8 +458,25 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         for (std::size_t i = 0; i < n; ++i) {
           fillWindows(ranges[i], y, cx, innerBegin, innerEnd, windows[i]);
         }
+        const ChunkInputs chunk{{windows.data(), n},
+                                {centreRows.data(), n},
+                                oc != nullptr
+                                    ? std::span<const std::uint8_t* const>{confidenceRows.data(), n}
+                                    : std::span<const std::uint8_t* const>{},
+                                cx,
+                                innerBegin,
+                                innerEnd};
+        decideChunk(chunk, tolerance, o, oc, decision);
       }
       for (int x = cx; x < cxEnd; ++x) {
+        const bool inner = innerRow && x > 0 && x + 1 < w;
+        const auto k = static_cast<std::size_t>(x - cx);
+        if (inner && decision.decided[k] != 0) {
+          if (k % 8 == 0 && x + 8 <= innerEnd && allDecided8(decision, k)) {
+            x += 7;  // and the ++x: eight decided pixels passed in one test
+          }
+          continue;
+        }
         o[x] = kNoDepth;
         if (oc != nullptr) {
           oc[x] = 0;
@@ -348,8 +502,6 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         const auto agrees = [low, span](std::uint16_t z) {
           return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
         };
-        const bool inner = innerRow && x > 0 && x + 1 < w;
-        const auto k = static_cast<std::size_t>(x - cx);
         if (inner && mergeFullWindows({windows.data(), n}, k, low, span, o[x],
                                       oc != nullptr ? ConfidenceAt{&confidenceRows, x, &oc[x]}
                                                     : ConfidenceAt{})) {
