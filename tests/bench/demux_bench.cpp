@@ -202,7 +202,7 @@ class Stages {
     kernels_.separation(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_,
                         filterRows_, workRows_, directionPlanes(),
                         std::span(separatedPlanes_).first(projectors_.size()),
-                        std::span(orderPlanes_).first(projectors_.size()));
+                        std::span(orderPlanes_).first(projectors_.size()), {0, h_});
   }
   void boundaries() {
     for (ProjectorOut& out : projectors_) {

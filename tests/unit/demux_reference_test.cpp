@@ -378,34 +378,42 @@ void checkInterpolation(const Frame& frame) {
 }
 
 // Given the smoothed planes, tile directions and direction planes, every projector's separated
-// planes and derivative orders are equal, and some pixels are of each order the frame has.
+// planes and derivative orders are equal, whether the schedule sweeps the image in one band or
+// in bands of uneven heights (the border rows alone among them), each band with working rows of
+// its own as a lane has; and some pixels are of each order the frame has.
 void checkSeparation(const Frame& frame) {
   const Stages in(frame);
   const DemuxLayout& l = in.frame.layout;
+  const std::vector<std::vector<int>> splits = {{0, in.h}, {0, 1, 3, in.h / 3, in.h - 2, in.h}};
   for (const Schedule& s : schedules()) {
-    std::vector<OwnedPlanes3> separated;
-    std::vector<OwnedPlane<std::uint8_t>> order;
-    std::vector<demux::Planes3> separatedViews;
-    std::vector<ImageView<std::uint8_t>> orderViews;
-    separated.reserve(in.separated.size());
-    order.reserve(in.order.size());
-    for (std::size_t p = 0; p < in.separated.size(); ++p) {
-      separatedViews.push_back(separated.emplace_back(in.w, in.h).views);
-      orderViews.push_back(order.emplace_back(in.w, in.h, std::uint8_t{9}).view);
-    }
-    auto filtered = rowMemory<std::int32_t>(demux::kFilterRows, in.w);
-    auto work = rowMemory<std::int16_t>(demux::kWorkRows, in.w);
-    s.kernels->separation(in.smoothed.views, l, in.tiles, in.columns, in.rows, in.units,
-                          demux::RowBlock<std::int32_t>(filtered, in.w),
-                          demux::RowBlock<std::int16_t>(work, in.w), in.directionViews(),
-                          separatedViews, orderViews);
-    for (std::size_t p = 0; p < separated.size(); ++p) {
-      for (std::size_t c = 0; c < 3; ++c) {
-        EXPECT_EQ(firstDifference(in.separated[p].views[c], separated[p].views[c]), "")
-            << s.name << ", projector " << p << ", channel " << c;
+    for (const std::vector<int>& edges : splits) {
+      const std::string bands = std::to_string(edges.size() - 1) + " band(s)";
+      std::vector<OwnedPlanes3> separated;
+      std::vector<OwnedPlane<std::uint8_t>> order;
+      std::vector<demux::Planes3> separatedViews;
+      std::vector<ImageView<std::uint8_t>> orderViews;
+      separated.reserve(in.separated.size());
+      order.reserve(in.order.size());
+      for (std::size_t p = 0; p < in.separated.size(); ++p) {
+        separatedViews.push_back(separated.emplace_back(in.w, in.h).views);
+        orderViews.push_back(order.emplace_back(in.w, in.h, std::uint8_t{9}).view);
       }
-      EXPECT_EQ(firstDifference(in.order[p].view, order[p].view), "")
-          << s.name << ", projector " << p;
+      for (std::size_t b = 0; b + 1 < edges.size(); ++b) {
+        auto filtered = rowMemory<std::int32_t>(demux::kFilterRows, in.w);
+        auto work = rowMemory<std::int16_t>(demux::kWorkRows, in.w);
+        s.kernels->separation(in.smoothed.views, l, in.tiles, in.columns, in.rows, in.units,
+                              demux::RowBlock<std::int32_t>(filtered, in.w),
+                              demux::RowBlock<std::int16_t>(work, in.w), in.directionViews(),
+                              separatedViews, orderViews, {edges[b], edges[b + 1]});
+      }
+      for (std::size_t p = 0; p < separated.size(); ++p) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          EXPECT_EQ(firstDifference(in.separated[p].views[c], separated[p].views[c]), "")
+              << s.name << ", " << bands << ", projector " << p << ", channel " << c;
+        }
+        EXPECT_EQ(firstDifference(in.order[p].view, order[p].view), "")
+            << s.name << ", " << bands << ", projector " << p;
+      }
     }
   }
   int nonzero = 0;

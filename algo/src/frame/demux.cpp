@@ -103,9 +103,13 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   for (auto& plane : smoothed_) {
     step(carveImage(carver, plane, l.width, l.height));
   }
-  // The last projector's separated planes take smoothed_'s memory: 3 planes less.
-  separated_[projectors - 1] = smoothed_;
-  for (std::size_t p = 0; p + 1 < projectors; ++p) {
+  // With one lane the last projector's separated planes take smoothed_'s memory: 3 planes
+  // less. Lanes separate bands of rows at once, each reading the rows beside its band.
+  const std::size_t ownPlanes = lanes_ == 1 ? projectors - 1 : projectors;
+  if (ownPlanes < projectors) {
+    separated_[projectors - 1] = smoothed_;
+  }
+  for (std::size_t p = 0; p < ownPlanes; ++p) {
     for (auto& plane : separated_[p]) {
       step(carveImage(carver, plane, l.width, l.height));
     }
@@ -113,11 +117,11 @@ Result<void> Demultiplexer::carve(Carver& carver) {
   for (int lane = 0; lane < lanes_; ++lane) {
     LaneScratch& scratch = laneScratch_[static_cast<std::size_t>(lane)];
     if (lane == 0) {
-      scratch.histogramRows = filterRows_;
+      scratch.filterRows = filterRows_;
       scratch.workRows = workRows_;
     } else {
-      step(carveSpan(carver, scratch.histogramRows,
-                     demux::RowBlock<std::int32_t>::valuesFor(demux::kHistogramRows, l.width)));
+      step(carveSpan(carver, scratch.filterRows,
+                     demux::RowBlock<std::int32_t>::valuesFor(demux::kFilterRows, l.width)));
       step(carveSpan(carver, scratch.workRows,
                      demux::RowBlock<std::int16_t>::valuesFor(demux::kSharedWorkRows, l.width)));
     }
@@ -192,11 +196,11 @@ Result<void> Demultiplexer::run(ConstRgbView image, JobRunner& jobs) {
     static_assert(demux::kHistogramRows <= demux::kFilterRows);
     const int tilesY = layout_.tilesY();
     auto band = [&](int b) {
-      kernels_->histogram(
-          smoothed_, layout_,
-          demux::RowBlock<std::int32_t>(laneScratch_[static_cast<std::size_t>(b)].histogramRows,
-                                        layout_.width),
-          tileHistograms_, tileMoments_, b * tilesY / lanes_, (b + 1) * tilesY / lanes_);
+      kernels_->histogram(smoothed_, layout_,
+                          demux::RowBlock<std::int32_t>(
+                              laneScratch_[static_cast<std::size_t>(b)].filterRows, layout_.width),
+                          tileHistograms_, tileMoments_, b * tilesY / lanes_,
+                          (b + 1) * tilesY / lanes_);
     };
     jobs.forEach(lanes_, band);
     // Each tile's window reaches into the neighbouring bands: the matching waits for all of them.
@@ -213,13 +217,19 @@ Result<void> Demultiplexer::run(ConstRgbView image, JobRunner& jobs) {
   kernels_->interpolation(layout_, tileDirections_, columns_, rows_,
                           demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
                           std::span<const DirectionPlane>(directions_.data(), projectors));
-  // Every projector separated in one sweep (the derivatives are shared), then its boundaries.
-  kernels_->separation(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
-                       demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
-                       demux::RowBlock<std::int16_t>(workRows_, layout_.width),
-                       std::span<const DirectionPlane>(directions_.data(), projectors),
-                       std::span<const demux::Planes3>(separated_.data(), projectors),
-                       std::span<const ImageView<std::uint8_t>>(order_.data(), projectors));
+  // Every projector separated in one sweep per band of rows (the derivatives are shared),
+  // then its boundaries.
+  auto separation = [&](int b) {
+    const LaneScratch& scratch = laneScratch_[static_cast<std::size_t>(b)];
+    kernels_->separation(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
+                         demux::RowBlock<std::int32_t>(scratch.filterRows, layout_.width),
+                         demux::RowBlock<std::int16_t>(scratch.workRows, layout_.width),
+                         std::span<const DirectionPlane>(directions_.data(), projectors),
+                         std::span<const demux::Planes3>(separated_.data(), projectors),
+                         std::span<const ImageView<std::uint8_t>>(order_.data(), projectors),
+                         {b * layout_.height / lanes_, (b + 1) * layout_.height / lanes_});
+  };
+  jobs.forEach(lanes_, separation);
   // separate() is done with its working rows: they hold detectBoundaries()' ring.
   const demux::TileColours colours{tileInverseColour_, layout_.tilesX(), columns_, rows_};
   auto lane = [&](int l) {

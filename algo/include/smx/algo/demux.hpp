@@ -116,8 +116,9 @@ class Demultiplexer {
   [[nodiscard]] Result<void> fixTileDirections(std::span<const TileDirection> tiles);
 
   // Debug view of the last run(): the projector's separated derivative per channel, before the
-  // division by the local colour (32 × grey level per pixel for the first order). The last
-  // projector's planes share the smoothed image's memory, so they hold until the next run().
+  // division by the local colour (32 × grey level per pixel for the first order). With one lane
+  // the last projector's planes share the smoothed image's memory, so they hold until the next
+  // run().
   [[nodiscard]] ImageView<const std::int16_t> separated(int projector, int channel) const;
 
  private:
@@ -125,10 +126,11 @@ class Demultiplexer {
   template <class Carver>
   [[nodiscard]] Result<void> carve(Carver& carver);
 
-  // A lane's working memory: for a band of tile rows' histograms, and for detecting one
-  // projector's boundaries besides its planes. Lane 0's rows are filterRows_ and workRows_.
+  // A lane's working memory: for a band of tile rows' histograms, a band of rows' separation
+  // and detecting one projector's boundaries besides its planes. Lane 0's rows are filterRows_
+  // and workRows_.
   struct LaneScratch {
-    std::span<std::int32_t> histogramRows;
+    std::span<std::int32_t> filterRows;
     std::span<std::int16_t> workRows;
     ImageView<std::uint16_t> strength;
     ImageView<std::uint16_t> derivativeStrength;
@@ -152,8 +154,8 @@ class Demultiplexer {
   std::span<TileDirection> tileDirections_;     // projectors × tileCount
   bool fixedDirections_ = false;                // fixTileDirections() was called
   std::array<ImageView<std::int16_t>, 3> smoothed_;
-  // Per projector; the last projector's planes share smoothed_'s memory (separate() reads each
-  // smoothed row before it writes there).
+  // Per projector; with one lane the last projector's planes share smoothed_'s memory
+  // (separate() reads each smoothed row before it writes there).
   std::array<std::array<ImageView<std::int16_t>, 3>, kMaxProjectors> separated_;
   std::array<ImageView<std::uint8_t>, kMaxProjectors> order_;
   std::array<LaneScratch, kMaxProjectors> laneScratch_;

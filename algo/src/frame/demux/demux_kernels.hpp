@@ -167,17 +167,25 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
                            const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out);
 
+// Output rows [begin, end) of separate(); it reads the input's rows begin − 2 … end + 1.
+struct RowRange {
+  int begin = 0;
+  int end = 0;
+};
+
 // Stage 3 for every projector in one sweep: per projector, the separated derivative per channel
 // (D, 32 × grey level per pixel for the first order) and the derivative order per pixel (1 or
-// 2; 0 on the border).
+// 2; 0 on the border), for the output rows `band` (any split of the image into bands gives the
+// same planes).
 // Output row y is written after row y + 2 of smoothed is read, and no row of smoothed is read
-// twice, so one projector's separated planes may take smoothed's memory.
+// twice, so with one band over the whole image one projector's separated planes may take
+// smoothed's memory; bands run at once may not (each reads the rows beside it).
 void separate(const Planes3& smoothed, const DemuxLayout& layout,
               std::span<const TileDirection> tiles, std::span<const TileInterp> columns,
               std::span<const TileInterp> rows, const UnitTable& units,
               const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
               std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
-              std::span<const ImageView<std::uint8_t>> order);
+              std::span<const ImageView<std::uint8_t>> order, RowRange band);
 
 // detectBoundaries()'s minStrength: the parameter's per mille of the local colour in Q4.11.
 [[nodiscard]] constexpr int minStrengthQ11(const DemuxParams& params) {

@@ -415,9 +415,11 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
               std::span<const TileInterp> rows, const UnitTable& units,
               const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
               std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
-              std::span<const ImageView<std::uint8_t>> order) {
+              std::span<const ImageView<std::uint8_t>> order, RowRange band) {
   const int w = layout.width;
   const int h = layout.height;
+  const int yBegin = std::max(band.begin, 0);
+  const int yEnd = std::min(band.end, h);
   const int projectors = layout.projectors;
   // The second derivatives are only ever steered with three projectors.
   const bool second = projectors == kMaxProjectors;
@@ -435,7 +437,9 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
       }
     }
   };
-  for (int row = 0; row < 4 && row < h; ++row) {
+  // The ring as the whole image's sweep has it at row yBegin: rows yBegin − 2 … yBegin + 1 (rows
+  // 0 … 3 before row 2, where the sweep starts filling).
+  for (int row = std::max(yBegin - 2, 0); row < std::min(std::max(yBegin, 2) + 2, h); ++row) {
     fill(row);
   }
 
@@ -461,7 +465,7 @@ void separate(const Planes3& smoothed, const DemuxLayout& layout,
   const PackedUnits packedUnits(units);
   int casesRow = -1;
 
-  for (int y = 0; y < h; ++y) {
+  for (int y = yBegin; y < yEnd; ++y) {
     if (y + 2 < h && y >= 2) {
       fill(y + 2);
     }
@@ -522,9 +526,9 @@ SMX_AVX2_TWIN void avx2::separate(
     std::span<const TileInterp> columns, std::span<const TileInterp> rows, const UnitTable& units,
     const RowBlock<std::int32_t>& filtered, const RowBlock<std::int16_t>& work,
     std::span<const DirectionPlane> directions, std::span<const Planes3> separated,
-    std::span<const ImageView<std::uint8_t>> order) {
+    std::span<const ImageView<std::uint8_t>> order, RowRange band) {
   demux::separate(smoothed, layout, tiles, columns, rows, units, filtered, work, directions,
-                  separated, order);
+                  separated, order, band);
 }
 #endif
 
