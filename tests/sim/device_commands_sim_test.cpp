@@ -4,10 +4,13 @@
 // and the calibration must find the true rig from the announced one.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -146,6 +149,36 @@ TEST(DeviceCommandsSim, WrongOptionsAreUsageErrorsAndNoDeviceIsExit3) {
   EXPECT_EQ(earlier.code, host::kExitUsage);
   EXPECT_NE(earlier.err.find("rig.captures already holds captures (pose00/)"), std::string::npos)
       << earlier.err;
+
+  // The table's form: its options only with --device --turntable, no poses, no earlier views.
+  EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--views", "6", "--target", "9x6",
+                 "--square", "0.03", "--out", "x.json"})
+                .code,
+            host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--turntable", "--rig", rig, "--captures", "c", "--span", "60",
+                 "--out", "x.json"})
+                .code,
+            host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--turntable", "--poses", "6", "--out",
+                 "x.json"})
+                .code,
+            host::kExitUsage);
+  EXPECT_EQ(cli({"calibrate", "--device", "127.0.0.1:1", "--turntable", "--views", "3", "--out",
+                 "x.json"})
+                .code,
+            host::kExitUsage);
+  fs::create_directories(out / "table.captures/view00");
+  const auto earlierViews =
+      cli({"calibrate", "--device", "127.0.0.1:1", "--turntable", "--target", "9x6", "--square",
+           "0.03", "--out", (out / "table.json").string()});
+  EXPECT_EQ(earlierViews.code, host::kExitUsage);
+  EXPECT_NE(earlierViews.err.find("table.captures already holds captures (view00/)"),
+            std::string::npos)
+      << earlierViews.err;
+  const auto noTable = cli({"calibrate", "--device", "127.0.0.1:1", "--turntable", "--target",
+                            "9x6", "--square", "0.03", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(noTable.code, host::kExitDeviceOrIo) << noTable.err;
+  EXPECT_FALSE(fs::exists(out / "rig.json"));
 }
 
 // `stripemux sim --calibration` scene, each pose held for `hold` frames, rendered at
@@ -205,6 +238,86 @@ TEST(DeviceCommandsSim, GuidedCalibrateOnADeviceFindsTheRenderedRig) {
   EXPECT_GT(distanceMm(announced.projectors[1], truth.projectors[1]), 5.9);
   EXPECT_LT(distanceMm(solved.projectors[1], truth.projectors[1]), 1.5);
   EXPECT_LT(distanceMm(solved.projectors[0], truth.projectors[0]), 3.0);
+}
+
+// Given the turntable board rendering the printed target leaning on its table (a `stripemux sim
+// --table-calibration` pose at 0 deg, the table's axis where that command puts it) and announcing
+// its rig without an axis, `calibrate --device --turntable --views 6` turns the table through six
+// angles, captures them into RIG.captures beside --out, turns the table back and solves: the axis
+// lies on the rendered one.
+TEST(DeviceCommandsSim, GuidedTableCalibrateOnADeviceFindsTheTablesAxis) {
+  const config::Board board = test::sourceBoard("sim-turntable");
+  const fs::path sim = scratch("table_sim");
+  const fs::path rigFile = kSource / "boards/sim-turntable/rig.json";
+  const auto rendered =
+      cli({"sim", "--rig", rigFile.string(), "--table-calibration", "5", "--out", sim.string()});
+  ASSERT_EQ(rendered.code, 0) << rendered.err;
+  std::ifstream axisIn(sim / "truth/axis.json");
+  const Json axis = Json::parse(axisIn);
+  std::ifstream sceneIn(sim / "truth/scene.json");
+  Json scene = Json::parse(sceneIn);
+  scene["supersampling"] = 1;
+  scene["turntable"] = {{"axis", axis["direction"]}, {"pivot", axis["point"]}};
+  ASSERT_EQ(scene["objects"].size(), 1U);
+  Json& sheet = scene["objects"][0];
+  const Json atZero = sheet["pose_sequence"]["poses"][2];  // of −40, −20, 0, 20, 40 deg
+  sheet["pose_sequence"]["poses"] = Json::array({atZero});
+  sheet["on_turntable"] = true;
+  const fs::path sceneFile = sim / "truth/table_scene.json";
+  std::ofstream(sceneFile) << scene.dump(2);
+  std::ifstream targetIn(sim / "target.json");
+  const Json target = Json::parse(targetIn);
+
+  algo::Rig announced = board.rig;
+  announced.turntable.reset();
+  const test::SimDevice device(test::renderingScene(board, sceneFile.string(), announced),
+                               {.loops = test::SimLoops::kServe, .renderedRig = board.rig});
+  const fs::path out = scratch("table_calibrated");
+  const auto run =
+      cli({"calibrate", "--device", device.address(), "--turntable", "--views", "6", "--target",
+           std::to_string(target["inner_corners"][0].get<int>()) + "x" +
+               std::to_string(target["inner_corners"][1].get<int>()),
+           "--square", std::to_string(target["square_m"].get<double>()), "--out",
+           (out / "rig.json").string()});
+  ASSERT_EQ(run.code, host::kExitOk) << run.err << "\n" << run.out;
+  EXPECT_NE(run.out.find("view05: captured at 40.0 deg"), std::string::npos) << run.out;
+  for (const char* file : {"target.json", "turntable.json", "view00/cam0.png", "view05/cam1.png"}) {
+    EXPECT_TRUE(fs::exists(out / "rig.captures" / file)) << file;
+  }
+  ASSERT_NE(device.hal().turntable, nullptr);
+  EXPECT_EQ(device.hal().turntable->position(), 0) << "the table is turned back";
+
+  const algo::Rig solved = loadRig(out / "rig.json");
+  ASSERT_TRUE(solved.turntable.has_value());
+  const auto vec = [](const Json& v) {
+    return std::array<double, 3>{v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+  };
+  const std::array<double, 3> d = vec(axis["direction"]);
+  const std::array<double, 3> p = vec(axis["point"]);
+  const std::array<double, 3>& a = solved.turntable->axis;
+  const double cosine = std::abs(a[0] * d[0] + a[1] * d[1] + a[2] * d[2]) /
+                        std::hypot(a[0], a[1], a[2]) / std::hypot(d[0], d[1], d[2]);
+  EXPECT_LT(std::acos(std::min(cosine, 1.0)) * 180.0 / std::numbers::pi, 0.3);
+  // The solved point's distance from the rendered line.
+  const std::array<double, 3> q = solved.turntable->point;
+  const std::array<double, 3> e{q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double along = (e[0] * d[0] + e[1] * d[1] + e[2] * d[2]) / std::hypot(d[0], d[1], d[2]);
+  const double off =
+      std::sqrt(std::max(0.0, e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - along * along));
+  EXPECT_LT(off, 0.002);
+}
+
+// Given a board without a turntable, `calibrate --device --turntable` says so and writes nothing.
+TEST(DeviceCommandsSim, GuidedTableCalibrateRefusesADeviceWithoutATable) {
+  const algo::Rig rig = loadRig(kSource / "boards/sim/rig_2proj_1cam.json");
+  const RenderingDevice device("plane", rig, rig);
+  const fs::path out = scratch("no_table");
+  const auto run = cli({"calibrate", "--device", device.address(), "--turntable", "--target", "9x6",
+                        "--square", "0.03", "--out", (out / "rig.json").string()});
+  EXPECT_EQ(run.code, host::kExitBadInput) << run.err;
+  EXPECT_NE(run.err.find("the device has no turntable"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(out / "rig.json"));
+  EXPECT_FALSE(fs::exists(out / "rig.captures/view00"));
 }
 
 }  // namespace

@@ -29,47 +29,6 @@ constexpr double kFrontalDeg = 15.0;  // a tilt below this counts as facing the 
 
 using calib::Target;
 
-// DIR/target.json when it exists (given options must agree), else the options (written there).
-std::expected<Target, std::string> resolveTarget(const fs::path& dir,
-                                                 const CaptureGuideOptions& options) {
-  const fs::path file = dir / "target.json";
-  if (fs::exists(file)) {
-    auto target = calib::loadTarget(file);
-    if (!target) {
-      return target;
-    }
-    const bool disagrees = (options.cols != 0 && options.cols != target->cols) ||
-                           (options.rows != 0 && options.rows != target->rows) ||
-                           (options.squareM != 0 && options.squareM != target->squareM);
-    if (disagrees) {
-      return Fail(file.string() + " describes another target than the options; remove one");
-    }
-    return target;
-  }
-  if (options.cols == 0 || options.rows == 0 || !(options.squareM > 0)) {
-    return Fail(
-        "no target: give its inner corners and square (--target COLSxROWS --square M) "
-        "or write " +
-        file.string());
-  }
-  const Target given{.cols = options.cols, .rows = options.rows, .squareM = options.squareM};
-  const std::string text = targetJson(given);
-  if (auto valid = calib::parseTarget(text); !valid) {
-    return Fail("--target/--square: " + valid.error());
-  }
-  auto out = OutputFolder::create(dir);
-  if (!out) {
-    return Fail(out.error());
-  }
-  if (auto ok = out->writeText("target.json", text); !ok) {
-    return Fail(ok.error());
-  }
-  if (auto ok = out->commit(); !ok) {
-    return Fail(ok.error());
-  }
-  return given;
-}
-
 using Corners = std::vector<cv::Point2f>;
 
 // The board's inner corners (calib::findTargetCorners, the calibration's own detector), or empty.
@@ -296,6 +255,46 @@ std::expected<bool, std::string> capturePose(DeviceClient& device, const algo::R
 
 }  // namespace
 
+std::expected<calib::Target, std::string> resolveCaptureTarget(const fs::path& dir, int cols,
+                                                               int rows, double squareM) {
+  const fs::path file = dir / "target.json";
+  if (fs::exists(file)) {
+    auto target = calib::loadTarget(file);
+    if (!target) {
+      return target;
+    }
+    const bool disagrees = (cols != 0 && cols != target->cols) ||
+                           (rows != 0 && rows != target->rows) ||
+                           (squareM != 0 && squareM != target->squareM);
+    if (disagrees) {
+      return Fail(file.string() + " describes another target than the options; remove one");
+    }
+    return target;
+  }
+  if (cols == 0 || rows == 0 || !(squareM > 0)) {
+    return Fail(
+        "no target: give its inner corners and square (--target COLSxROWS --square M) "
+        "or write " +
+        file.string());
+  }
+  const Target given{.cols = cols, .rows = rows, .squareM = squareM};
+  const std::string text = targetJson(given);
+  if (auto valid = calib::parseTarget(text); !valid) {
+    return Fail("--target/--square: " + valid.error());
+  }
+  auto out = OutputFolder::create(dir);
+  if (!out) {
+    return Fail(out.error());
+  }
+  if (auto ok = out->writeText("target.json", text); !ok) {
+    return Fail(ok.error());
+  }
+  if (auto ok = out->commit(); !ok) {
+    return Fail(ok.error());
+  }
+  return given;
+}
+
 std::expected<std::pair<int, int>, std::string> parseInnerCorners(const std::string& text) {
   const auto fail =
       Fail("--target: expected COLSxROWS inner corners, e.g. 9x6, got \"" + printable(text) + "\"");
@@ -330,7 +329,7 @@ std::expected<CaptureSummary, std::string> captureCalibrationSet(DeviceClient& d
   if (options.poses < 1) {
     return Fail("at least one pose is needed");
   }
-  const auto target = resolveTarget(dir, options);
+  const auto target = resolveCaptureTarget(dir, options.cols, options.rows, options.squareM);
   if (!target) {
     return Fail(target.error());
   }

@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "device_client.hpp"
 #include "smx/algo/rig.hpp"
+#include "smx/calib/target.hpp"
 
 // The guided calibration capture (docs/cli.md, "capture --guided"): for each pose it watches
 // projector-off frames until the checkerboard is found in the first camera and holds still,
@@ -49,6 +50,11 @@ struct CaptureSummary {
   int cellsHit = 0;  // coverage grid cells of the first camera holding a corner of some pose
   int cells = 0;
 };
+
+// DIR/target.json when it exists (given values must agree with it; 0 = not given), else the
+// given target, written there.
+[[nodiscard]] std::expected<calib::Target, std::string> resolveCaptureTarget(
+    const std::filesystem::path& dir, int cols, int rows, double squareM);
 
 // "9x6" → {9, 6}: the --target option's inner corners COLSxROWS, or why not.
 [[nodiscard]] std::expected<std::pair<int, int>, std::string> parseInnerCorners(

@@ -1,9 +1,10 @@
 // stripemux calibrate --rig NOMINAL.json --captures DIR --out RIG.json [--report DIR]
 // stripemux calibrate --device HOST[:PORT] --poses N --out RIG.json [--captures DIR] [--report DIR]
 // stripemux calibrate --turntable --rig RIG.json --captures DIR --out RIG2.json
-// A rig's cameras and projectors from captures of a printed target (docs/calibration.md), taken
-// beforehand or, with --device, by the guided capture first. The rig file is written only when
-// the solve succeeds, and then whole or not at all.
+// stripemux calibrate --turntable --device HOST[:PORT] --out RIG2.json [--views N] [--span DEG]
+// A rig's cameras and projectors, or its turntable's axis, from captures of a printed target
+// (docs/calibration.md), taken beforehand or, with --device, by the guided capture first. The rig
+// file is written only when the solve succeeds, and then whole or not at all.
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "smx/calib/report.hpp"
 #include "smx/calib/table_captures.hpp"
 #include "smx/config/rig_json.hpp"
+#include "table_capture.hpp"
 
 namespace smx::host {
 namespace {
@@ -35,8 +37,11 @@ struct CalibrateOptions {
   int poses = 12;
   std::string target;  // COLSxROWS inner corners
   double squareM = 0;
-  // The turntable's axis from captures of the target on the table, added to a calibrated rig.
+  // The turntable's axis from captures of the target on the table, added to a calibrated rig;
+  // with --device, `views` of them over `spanDeg`, the device turning its table.
   bool turntable = false;
+  int views = 8;
+  double spanDeg = 80.0;
 };
 
 int fail(const CliStreams& io, int code, const std::string& message) {
@@ -104,30 +109,23 @@ int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
   return solveAndWrite(*nominal, opts, io);
 }
 
-// --turntable: the rig with the table's axis; its cameras must be calibrated already.
-int runTableCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
+// --turntable: `rig` with the table's axis from the captures; its cameras must be calibrated.
+int solveTableAndWrite(algo::Rig rig, const CalibrateOptions& opts, const CliStreams& io) {
   const fs::path outFile = opts.out.filename();
-  if (const auto problem = fileNameProblem(outFile.string())) {
-    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
-  }
   const std::string untouched = "; nothing written (" + opts.out.string() + ")";
-  auto rig = config::loadRig(opts.rig);
-  if (!rig) {
-    return fail(io, kExitBadInput, rig.error().message() + untouched);
-  }
-  auto table = calib::calibrateTable(*rig, opts.captures);
+  auto table = calib::calibrateTable(rig, opts.captures);
   if (!table) {
     return fail(io, kExitBadInput, table.error() + untouched);
   }
   const auto& axis = table->axis;
-  rig->turntable =
+  rig.turntable =
       algo::TurntableAxis{.axis = {axis.direction.x(), axis.direction.y(), axis.direction.z()},
                           .point = {axis.point.x(), axis.point.y(), axis.point.z()}};
   auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");
   if (!rigDir) {
     return fail(io, kExitDeviceOrIo, rigDir.error());
   }
-  if (auto ok = rigDir->writeText(outFile.string(), config::toJson(*rig)); !ok) {
+  if (auto ok = rigDir->writeText(outFile.string(), config::toJson(rig)); !ok) {
     return fail(io, kExitDeviceOrIo, ok.error());
   }
   if (auto ok = rigDir->commit(); !ok) {
@@ -137,9 +135,79 @@ int runTableCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
   return kExitOk;
 }
 
+int runTableCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
+  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
+    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  }
+  auto rig = config::loadRig(opts.rig);
+  if (!rig) {
+    return fail(io, kExitBadInput,
+                rig.error().message() + "; nothing written (" + opts.out.string() + ")");
+  }
+  return solveTableAndWrite(std::move(*rig), opts, io);
+}
+
 // RIG.json → RIG.captures beside it.
 fs::path defaultCaptures(const fs::path& out) {
   return out.parent_path() / (out.stem().string() + ".captures");
+}
+
+// The target from --target and --square, or nothing given (0s); a malformed --target is the
+// error.
+std::expected<std::tuple<int, int, double>, std::string> givenTarget(const CalibrateOptions& opts) {
+  if (opts.target.empty()) {
+    return std::tuple{0, 0, opts.squareM};
+  }
+  const auto corners = parseInnerCorners(opts.target);
+  if (!corners) {
+    return std::unexpected(corners.error());
+  }
+  return std::tuple{corners->first, corners->second, opts.squareM};
+}
+
+// --turntable --device: the device turns its table through the views, then the axis is solved
+// with the device's rig.
+int runDeviceTableCalibrate(CalibrateOptions opts, const CliStreams& io) {
+  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
+    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  }
+  TableCaptureOptions capture;
+  capture.views = opts.views;
+  capture.spanDeg = opts.spanDeg;
+  const auto target = givenTarget(opts);
+  if (!target) {
+    return fail(io, kExitUsage, target.error());
+  }
+  std::tie(capture.cols, capture.rows, capture.squareM) = *target;
+  if (opts.captures.empty()) {
+    opts.captures = defaultCaptures(opts.out);
+  }
+  // Views of an earlier session beside new ones would be solved as one turn.
+  std::error_code ec;
+  if (fs::exists(opts.captures / "view00", ec)) {
+    return fail(io, kExitUsage,
+                opts.captures.string() +
+                    " already holds captures (view00/): give another --captures or remove them");
+  }
+  if ((capture.cols == 0 || capture.squareM == 0) &&
+      !fs::exists(opts.captures / "target.json", ec)) {
+    return fail(io, kExitUsage,
+                "no target: give --target COLSxROWS and --square M, or write " +
+                    (opts.captures / "target.json").string());
+  }
+  auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
+  if (!client) {
+    return fail(io, kExitDeviceOrIo, client.error());
+  }
+  algo::Rig rig = client->info().rig;
+  const auto captured = captureTableSet(*client, rig, capture, opts.captures, io);
+  client->close();
+  if (!captured) {
+    const bool noTable = captured.error().starts_with("the device has no turntable");
+    return fail(io, noTable ? kExitBadInput : kExitDeviceOrIo,
+                captured.error() + "; nothing written (" + opts.out.string() + ")");
+  }
+  return solveTableAndWrite(std::move(rig), opts, io);
 }
 
 int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
@@ -149,14 +217,11 @@ int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
   }
   CaptureGuideOptions guide;
   guide.poses = opts.poses;
-  guide.squareM = opts.squareM;
-  if (!opts.target.empty()) {
-    const auto corners = parseInnerCorners(opts.target);
-    if (!corners) {
-      return fail(io, kExitUsage, corners.error());
-    }
-    std::tie(guide.cols, guide.rows) = *corners;
+  const auto target = givenTarget(opts);
+  if (!target) {
+    return fail(io, kExitUsage, target.error());
   }
+  std::tie(guide.cols, guide.rows, guide.squareM) = *target;
   if (opts.captures.empty()) {
     opts.captures = defaultCaptures(opts.out);
   }
@@ -203,11 +268,13 @@ void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--report", opts->report, "Folder for report.json and summary.txt");
   auto* device = cmd->add_option(
       "--device", opts->device,
-      "HOST[:PORT] of a device: capture the poses there (guided), then solve with its rig");
+      "HOST[:PORT] of a device: capture the poses (with --turntable, the table's views) there, "
+      "guided, then solve with its rig");
   device->check(deviceAddressValidator())->excludes(rig);
-  cmd->add_option("--poses", opts->poses, "With --device: poses to capture (default 12)")
-      ->check(CLI::Range(1, 100))
-      ->needs(device);
+  auto* poses =
+      cmd->add_option("--poses", opts->poses, "With --device: poses to capture (default 12)")
+          ->check(CLI::Range(1, 100))
+          ->needs(device);
   cmd->add_option("--target", opts->target,
                   "With --device: the checkerboard's inner corners COLSxROWS, e.g. 9x6 (else "
                   "<captures>/target.json)")
@@ -215,14 +282,30 @@ void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   cmd->add_option("--square", opts->squareM, "With --device: the checkerboard's square, metres")
       ->check(CLI::Range(1e-4, 1.0))
       ->needs(device);
-  cmd->add_flag("--turntable", opts->turntable,
-                "Find the turntable's axis from --captures of the target on the table (see "
-                "stripemux sim --table-calibration) and write --rig with it")
-      ->excludes(device);
+  auto* turntable =
+      cmd->add_flag("--turntable", opts->turntable,
+                    "Find the turntable's axis from --captures of the target leaning on the table "
+                    "(see stripemux sim --table-calibration) and write --rig with it; with "
+                    "--device, the device turns its table and the views are captured first")
+          ->excludes(poses);
+  cmd->add_option("--views", opts->views,
+                  "With --device --turntable: table angles to capture (default 8)")
+      ->check(CLI::Range(4, 72))
+      ->needs(device)
+      ->needs(turntable);
+  cmd->add_option("--span", opts->spanDeg,
+                  "With --device --turntable: degrees the views spread over, centred where the "
+                  "table stands (default 80)")
+      ->check(CLI::Range(30.0, 360.0))
+      ->needs(device)
+      ->needs(turntable);
   cmd->callback([opts, device, rig, captures, &io, &exitCode] {
-    if (opts->turntable) {
+    if (opts->turntable && device->count() > 0) {
+      exitCode = runDeviceTableCalibrate(*opts, io);
+    } else if (opts->turntable) {
       exitCode = rig->count() == 0 || captures->count() == 0
-                     ? fail(io, kExitUsage, "--turntable needs --rig (calibrated) and --captures")
+                     ? fail(io, kExitUsage,
+                            "--turntable needs --rig (calibrated) and --captures, or --device")
                      : runTableCalibrate(*opts, io);
     } else if (device->count() > 0) {
       exitCode = runDeviceCalibrate(*opts, io);
