@@ -196,7 +196,7 @@ class Stages {
   }
   void interpolate() {
     kernels_.interpolation(layout_, tileDirections_, columns_, rows_, filterRows_,
-                           directionPlanes());
+                           directionPlanes(), {0, h_});
   }
   void separate() {
     kernels_.separation(smoothed_.views, layout_, tileDirections_, columns_, rows_, units_,

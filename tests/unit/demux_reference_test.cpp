@@ -357,34 +357,57 @@ void checkDirections(const Frame& frame) {
   }
 }
 
-// Given the tile directions, every projector's direction plane is equal.
+// Given the tile directions, every projector's direction plane is equal, whether the schedule
+// interpolates the image in one band or in bands of uneven heights, each with working rows of its
+// own (one band's edge inside a tile row's band of rows).
 void checkInterpolation(const Frame& frame) {
   const Stages in(frame);
+  const std::vector<std::vector<int>> splits = {{0, in.h}, {0, 1, 3, in.h / 3 + 1, in.h}};
   for (const Schedule& s : schedules()) {
-    std::vector<OwnedPlane<std::uint16_t>> got;
-    std::vector<DirectionPlane> views;
-    got.reserve(in.directions.size());
-    for (std::size_t p = 0; p < in.directions.size(); ++p) {
-      views.push_back(got.emplace_back(in.w, in.h, std::uint16_t{0x5A5A}).view);
+    for (const std::vector<int>& edges : splits) {
+      std::vector<OwnedPlane<std::uint16_t>> got;
+      std::vector<DirectionPlane> views;
+      got.reserve(in.directions.size());
+      for (std::size_t p = 0; p < in.directions.size(); ++p) {
+        views.push_back(got.emplace_back(in.w, in.h, std::uint16_t{0x5A5A}).view);
+      }
+      for (std::size_t b = 0; b + 1 < edges.size(); ++b) {
+        auto band = rowMemory<std::int32_t>(demux::kInterpolationRows, in.w);
+        s.kernels->interpolation(in.frame.layout, in.tiles, in.columns, in.rows,
+                                 demux::RowBlock<std::int32_t>(band, in.w), views,
+                                 {edges[b], edges[b + 1]});
+      }
+      for (std::size_t p = 0; p < got.size(); ++p) {
+        EXPECT_EQ(firstDifference(in.directions[p].view, got[p].view), "")
+            << s.name << ", " << edges.size() - 1 << " band(s), projector " << p;
+      }
     }
+    // A band writes its own rows only: lanes write theirs at once.
+    OwnedPlane<std::uint16_t> alone(in.w, in.h, std::uint16_t{0x5A5A});
+    const std::vector<DirectionPlane> aloneViews(in.directions.size(), alone.view);
     auto band = rowMemory<std::int32_t>(demux::kInterpolationRows, in.w);
     s.kernels->interpolation(in.frame.layout, in.tiles, in.columns, in.rows,
-                             demux::RowBlock<std::int32_t>(band, in.w), views);
-    for (std::size_t p = 0; p < got.size(); ++p) {
-      EXPECT_EQ(firstDifference(in.directions[p].view, got[p].view), "")
-          << s.name << ", projector " << p;
+                             demux::RowBlock<std::int32_t>(band, in.w), aloneViews, {3, in.h / 3});
+    int outside = 0;
+    for (int y = 0; y < in.h; ++y) {
+      for (int x = 0; x < in.w; ++x) {
+        outside += (y < 3 || y >= in.h / 3) && alone.view(x, y) != 0x5A5A ? 1 : 0;
+      }
     }
+    EXPECT_EQ(outside, 0) << s.name << ": pixels written outside the band";
   }
 }
 
 // Given the smoothed planes, tile directions and direction planes, every projector's separated
 // planes and derivative orders are equal, whether the schedule sweeps the image in one band or
 // in bands of uneven heights (the border rows alone among them), each band with working rows of
-// its own as a lane has; and some pixels are of each order the frame has.
+// its own as a lane has; a band alone writes its rows only; and some pixels are of each order
+// the frame has.
 void checkSeparation(const Frame& frame) {
   const Stages in(frame);
   const DemuxLayout& l = in.frame.layout;
-  const std::vector<std::vector<int>> splits = {{0, in.h}, {0, 1, 3, in.h / 3, in.h - 2, in.h}};
+  const std::vector<std::vector<int>> splits = {
+      {0, in.h}, {0, 1, 3, in.h / 3, in.h - 2, in.h}, {3, in.h / 3}};
   for (const Schedule& s : schedules()) {
     for (const std::vector<int>& edges : splits) {
       const std::string bands = std::to_string(edges.size() - 1) + " band(s)";
@@ -406,13 +429,26 @@ void checkSeparation(const Frame& frame) {
                               demux::RowBlock<std::int16_t>(work, in.w), in.directionViews(),
                               separatedViews, orderViews, {edges[b], edges[b + 1]});
       }
-      for (std::size_t p = 0; p < separated.size(); ++p) {
+      const bool whole = edges.front() == 0 && edges.back() == in.h;
+      for (std::size_t p = 0; p < separated.size() && whole; ++p) {
         for (std::size_t c = 0; c < 3; ++c) {
           EXPECT_EQ(firstDifference(in.separated[p].views[c], separated[p].views[c]), "")
               << s.name << ", " << bands << ", projector " << p << ", channel " << c;
         }
         EXPECT_EQ(firstDifference(in.order[p].view, order[p].view), "")
             << s.name << ", " << bands << ", projector " << p;
+      }
+      // A band alone writes its own rows only (lanes write theirs at once), as the whole sweep.
+      for (std::size_t p = 0; p < separated.size() && !whole; ++p) {
+        int wrong = 0;
+        for (int y = 0; y < in.h; ++y) {
+          const bool inside = y >= edges.front() && y < edges.back();
+          for (int x = 0; x < in.w; ++x) {
+            wrong += order[p].view(x, y) != (inside ? in.order[p].view(x, y) : 9) ? 1 : 0;
+          }
+        }
+        EXPECT_EQ(wrong, 0) << s.name << ", rows " << edges.front() << " to " << edges.back()
+                            << " alone, projector " << p;
       }
     }
   }

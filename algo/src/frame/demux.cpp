@@ -214,20 +214,20 @@ Result<void> Demultiplexer::run(ConstRgbView image, JobRunner& jobs) {
   }
   const auto projectors = static_cast<std::size_t>(layout_.projectors);
   static_assert(demux::kInterpolationRows <= demux::kFilterRows);
-  kernels_->interpolation(layout_, tileDirections_, columns_, rows_,
-                          demux::RowBlock<std::int32_t>(filterRows_, layout_.width),
-                          std::span<const DirectionPlane>(directions_.data(), projectors));
-  // Every projector separated in one sweep per band of rows (the derivatives are shared),
-  // then its boundaries.
+  // Per band of rows: the directions there (separation reads only its own rows'), then every
+  // projector separated in one sweep (the derivatives are shared); then the boundaries.
   auto separation = [&](int b) {
     const LaneScratch& scratch = laneScratch_[static_cast<std::size_t>(b)];
+    const demux::RowRange band{b * layout_.height / lanes_, (b + 1) * layout_.height / lanes_};
+    const std::span<const DirectionPlane> directions(directions_.data(), projectors);
+    kernels_->interpolation(layout_, tileDirections_, columns_, rows_,
+                            demux::RowBlock<std::int32_t>(scratch.filterRows, layout_.width),
+                            directions, band);
     kernels_->separation(smoothed_, layout_, tileDirections_, columns_, rows_, units_[0],
                          demux::RowBlock<std::int32_t>(scratch.filterRows, layout_.width),
-                         demux::RowBlock<std::int16_t>(scratch.workRows, layout_.width),
-                         std::span<const DirectionPlane>(directions_.data(), projectors),
+                         demux::RowBlock<std::int16_t>(scratch.workRows, layout_.width), directions,
                          std::span<const demux::Planes3>(separated_.data(), projectors),
-                         std::span<const ImageView<std::uint8_t>>(order_.data(), projectors),
-                         {b * layout_.height / lanes_, (b + 1) * layout_.height / lanes_});
+                         std::span<const ImageView<std::uint8_t>>(order_.data(), projectors), band);
   };
   jobs.forEach(lanes_, separation);
   // separate() is done with its working rows: they hold detectBoundaries()' ring.

@@ -158,25 +158,27 @@ inline constexpr std::size_t kWorkRows = 33;
   return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b));
 }
 
-// Every projector's direction plane: its tile angles interpolated bilinearly between tile
-// centres (as wrapped differences from the lower-left tile's). band: kInterpolationRows working
-// rows of the image's width (run() lends separate()'s filter rows), the per-pixel terms shared
-// by a band of rows between two tile rows' centres.
-inline constexpr std::size_t kInterpolationRows = 4;
-void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
-                           std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-                           const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out);
-
-// Output rows [begin, end) of separate(); it reads the input's rows begin − 2 … end + 1.
+// Rows [begin, end) of a plane that a stage writes: any split of the image into such bands gives
+// the same planes, so lanes may each take one.
 struct RowRange {
   int begin = 0;
   int end = 0;
 };
 
+// Every projector's direction plane, rows `rows`: its tile angles interpolated bilinearly between
+// tile centres (as wrapped differences from the lower-left tile's). band: kInterpolationRows
+// working rows of the image's width (run() lends separate()'s filter rows), the per-pixel terms
+// shared by a band of rows between two tile rows' centres.
+inline constexpr std::size_t kInterpolationRows = 4;
+void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
+                           std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+                           const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out,
+                           RowRange outRows);
+
 // Stage 3 for every projector in one sweep: per projector, the separated derivative per channel
 // (D, 32 × grey level per pixel for the first order) and the derivative order per pixel (1 or
-// 2; 0 on the border), for the output rows `band` (any split of the image into bands gives the
-// same planes).
+// 2; 0 on the border), for the output rows `band`; it reads the input's rows band.begin − 2 …
+// band.end + 1.
 // Output row y is written after row y + 2 of smoothed is read, and no row of smoothed is read
 // twice, so with one band over the whole image one projector's separated planes may take
 // smoothed's memory; bands run at once may not (each reads the rows beside it).

@@ -1,6 +1,7 @@
 // Direction planes, the schedule of interpolateDirections() (reference:
 // reference/interpolate.cpp): each projector's tile angles interpolated bilinearly between tile
 // centres, as wrapped differences from the lower-left tile's angle, per pixel.
+#include <algorithm>
 #include <cstdint>
 
 #include "demux_kernels.hpp"
@@ -70,9 +71,11 @@ void bandLines(const TileDirection* lowerRow, const TileDirection* upperRow, int
 
 void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirection> tiles,
                            std::span<const TileInterp> columns, std::span<const TileInterp> rows,
-                           const RowBlock<std::int32_t>& band,
-                           std::span<const DirectionPlane> out) {
+                           const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out,
+                           RowRange outRows) {
   const int tilesX = layout.tilesX();
+  const int yBegin = std::max(outRows.begin, 0);
+  const int yEnd = std::min(outRows.end, layout.height);
   const std::size_t tileCount = layout.tileCount();
   const int w = layout.width;
   const std::int32_t* a00 = band.row(kA00);
@@ -83,7 +86,7 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
     const TileDirection* mine = tiles.data() + static_cast<std::size_t>(q) * tileCount;
     int lower = -1;
     int upper = -1;
-    for (int y = 0; y < layout.height; ++y) {
+    for (int y = yBegin; y < yEnd; ++y) {
       const TileInterp& ry = rows[static_cast<std::size_t>(y)];
       if (ry.lower != lower || ry.upper != upper) {
         lower = ry.lower;
@@ -103,13 +106,11 @@ void interpolateDirections(const DemuxLayout& layout, std::span<const TileDirect
 }
 
 #if SMX_DEMUX_AVX2
-SMX_AVX2_TWIN void avx2::interpolateDirections(const DemuxLayout& layout,
-                                               std::span<const TileDirection> tiles,
-                                               std::span<const TileInterp> columns,
-                                               std::span<const TileInterp> rows,
-                                               const RowBlock<std::int32_t>& band,
-                                               std::span<const DirectionPlane> out) {
-  demux::interpolateDirections(layout, tiles, columns, rows, band, out);
+SMX_AVX2_TWIN void avx2::interpolateDirections(
+    const DemuxLayout& layout, std::span<const TileDirection> tiles,
+    std::span<const TileInterp> columns, std::span<const TileInterp> rows,
+    const RowBlock<std::int32_t>& band, std::span<const DirectionPlane> out, RowRange outRows) {
+  demux::interpolateDirections(layout, tiles, columns, rows, band, out, outRows);
 }
 #endif
 
