@@ -165,36 +165,50 @@ std::expected<std::tuple<int, int, double>, std::string> givenTarget(const Calib
   return std::tuple{corners->first, corners->second, opts.squareM};
 }
 
+// What the guided forms check before connecting: --out's name, a captures folder (default
+// RIG.captures beside --out, set in opts) without an earlier session's `first` folder, and a
+// target given or on file. The target's inner corners and square (0s: on file), or the exit code
+// after the message.
+std::expected<std::tuple<int, int, double>, int> checkBeforeCapture(CalibrateOptions& opts,
+                                                                    const std::string& first,
+                                                                    const CliStreams& io) {
+  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
+    return std::unexpected(fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem));
+  }
+  const auto target = givenTarget(opts);
+  if (!target) {
+    return std::unexpected(fail(io, kExitUsage, target.error()));
+  }
+  if (opts.captures.empty()) {
+    opts.captures = defaultCaptures(opts.out);
+  }
+  // Captures of an earlier session beside new ones would be solved as one set.
+  std::error_code ec;
+  if (fs::exists(opts.captures / first, ec)) {
+    return std::unexpected(fail(io, kExitUsage,
+                                opts.captures.string() + " already holds captures (" + first +
+                                    "/): give another --captures or remove them"));
+  }
+  const auto& [cols, rows, squareM] = *target;
+  if ((cols == 0 || squareM == 0) && !fs::exists(opts.captures / "target.json", ec)) {
+    return std::unexpected(fail(io, kExitUsage,
+                                "no target: give --target COLSxROWS and --square M, or write " +
+                                    (opts.captures / "target.json").string()));
+  }
+  return *target;
+}
+
 // --turntable --device: the device turns its table through the views, then the axis is solved
 // with the device's rig.
 int runDeviceTableCalibrate(CalibrateOptions opts, const CliStreams& io) {
-  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
-    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  const auto target = checkBeforeCapture(opts, "view00", io);
+  if (!target) {
+    return target.error();
   }
   TableCaptureOptions capture;
   capture.views = opts.views;
   capture.spanDeg = opts.spanDeg;
-  const auto target = givenTarget(opts);
-  if (!target) {
-    return fail(io, kExitUsage, target.error());
-  }
   std::tie(capture.cols, capture.rows, capture.squareM) = *target;
-  if (opts.captures.empty()) {
-    opts.captures = defaultCaptures(opts.out);
-  }
-  // Views of an earlier session beside new ones would be solved as one turn.
-  std::error_code ec;
-  if (fs::exists(opts.captures / "view00", ec)) {
-    return fail(io, kExitUsage,
-                opts.captures.string() +
-                    " already holds captures (view00/): give another --captures or remove them");
-  }
-  if ((capture.cols == 0 || capture.squareM == 0) &&
-      !fs::exists(opts.captures / "target.json", ec)) {
-    return fail(io, kExitUsage,
-                "no target: give --target COLSxROWS and --square M, or write " +
-                    (opts.captures / "target.json").string());
-  }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
@@ -212,31 +226,13 @@ int runDeviceTableCalibrate(CalibrateOptions opts, const CliStreams& io) {
 
 int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
   // What can be checked without the device is, before connecting.
-  if (const auto problem = fileNameProblem(opts.out.filename().string())) {
-    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+  const auto target = checkBeforeCapture(opts, "pose00", io);
+  if (!target) {
+    return target.error();
   }
   CaptureGuideOptions guide;
   guide.poses = opts.poses;
-  const auto target = givenTarget(opts);
-  if (!target) {
-    return fail(io, kExitUsage, target.error());
-  }
   std::tie(guide.cols, guide.rows, guide.squareM) = *target;
-  if (opts.captures.empty()) {
-    opts.captures = defaultCaptures(opts.out);
-  }
-  // Poses of an earlier session beside new ones would be solved as one rig.
-  std::error_code ec;
-  if (fs::exists(opts.captures / "pose00", ec)) {
-    return fail(io, kExitUsage,
-                opts.captures.string() +
-                    " already holds captures (pose00/): give another --captures or remove them");
-  }
-  if ((guide.cols == 0 || guide.squareM == 0) && !fs::exists(opts.captures / "target.json", ec)) {
-    return fail(io, kExitUsage,
-                "no target: give --target COLSxROWS and --square M, or write " +
-                    (opts.captures / "target.json").string());
-  }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
     return fail(io, kExitDeviceOrIo, client.error());
