@@ -134,6 +134,6 @@ del rig["turntable"]
 json.dump(rig, open(sys.argv[1], "w"))
 PY
 start "$work/no_axis"
-refused 2 "calibrate --turntable" "$work/no_axis_scan"
+refused 2 "calibrate --device $device --turntable" "$work/no_axis_scan"
 stop
 echo "scan: turntable and hand-held scans whole, refusals clean"

@@ -111,7 +111,10 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io, LiveView* li
   if (!info.rig.turntable) {
     return fail(io, kExitBadInput,
                 "the device's rig has no turntable axis: calibrate it (stripemux calibrate "
-                "--turntable) and install the rig (stripemux config set rig=RIG.json)");
+                "--device " +
+                    printable(opts.device) +
+                    " --turntable --out RIG.json) and install the rig (stripemux config set "
+                    "rig=RIG.json)");
   }
   auto writer = ViewsWriter::create(opts.out, info.rig, info.rigJson, scan::ScanMode::kTurntable);
   if (!writer) {
