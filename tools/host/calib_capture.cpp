@@ -170,14 +170,6 @@ std::string poseName(std::size_t index) {
   return "pose" + std::string(number.size() < 2 ? 2 - number.size() : 0, '0') + number;
 }
 
-std::string oneDecimal(double v) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(1);
-  s << v;
-  return s.str();
-}
-
 struct Accepted {
   std::string name;
   BoardView view;
@@ -254,6 +246,14 @@ std::expected<bool, std::string> capturePose(DeviceClient& device, const algo::R
 }
 
 }  // namespace
+
+std::string oneDecimal(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v;
+  return s.str();
+}
 
 std::expected<calib::Target, std::string> resolveCaptureTarget(const fs::path& dir, int cols,
                                                                int rows, double squareM) {

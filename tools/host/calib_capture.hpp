@@ -56,6 +56,9 @@ struct CaptureSummary {
 [[nodiscard]] std::expected<calib::Target, std::string> resolveCaptureTarget(
     const std::filesystem::path& dir, int cols, int rows, double squareM);
 
+// v with one decimal, as the guided captures print angles and sizes.
+[[nodiscard]] std::string oneDecimal(double v);
+
 // "9x6" → {9, 6}: the --target option's inner corners COLSxROWS, or why not.
 [[nodiscard]] std::expected<std::pair<int, int>, std::string> parseInnerCorners(
     const std::string& text);

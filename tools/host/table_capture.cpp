@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdint>
 #include <ostream>
-#include <sstream>
 #include <vector>
 
 #include "calib_capture.hpp"
@@ -24,11 +23,7 @@ constexpr int kMinViews = 4;
 constexpr double kMinSpanDeg = 30.0;
 
 std::string degrees(double deg) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(1);
-  s << deg;
-  return s.str() + " deg";
+  return oneDecimal(deg) + " deg";
 }
 
 std::string failure(const TurntableFailure& f) {

@@ -217,9 +217,14 @@ std::uint16_t reference(const std::array<std::uint16_t, kMaxRanges>& centre, std
 }
 
 // The merged confidence from the smallest predicted error among the agreeing ranges.
+// The same from kInverseSqrtQ8[agreeing] (decideChunk() selects it in vector lanes).
+std::int32_t confidenceOfInverse(std::int32_t error, std::int32_t inverseSqrtQ8) {
+  return 255 - std::min((error * inverseSqrtQ8 + 128) >> 8, 254);
+}
+
 std::uint8_t mergedConfidence(std::int32_t error, int agreeing) {
-  const std::int32_t e = (error * kInverseSqrtQ8[static_cast<std::size_t>(agreeing)] + 128) >> 8;
-  return static_cast<std::uint8_t>(255 - (e > 254 ? 254 : e));
+  return static_cast<std::uint8_t>(
+      confidenceOfInverse(error, kInverseSqrtQ8[static_cast<std::size_t>(agreeing)]));
 }
 
 // Where the merged confidence goes, with the ranges' confidences at the pixel (none: no
@@ -382,9 +387,9 @@ void decideChunk(const ChunkInputs& in, const DepthTolerance& tolerance, std::ui
       }
     }
     for (std::size_t k = kBegin; k < kEnd; ++k) {
-      const std::int32_t e = std::min((d.error[k] * d.inverse[k] + 128) >> 8, 254);
       const std::int32_t depth = d.first[k] != kNoDepth ? 1 : 0;
-      outConfidence[cx + k] = static_cast<std::uint8_t>((255 - e) & -depth);
+      outConfidence[cx + k] =
+          static_cast<std::uint8_t>(confidenceOfInverse(d.error[k], d.inverse[k]) & -depth);
     }
   }
 }
@@ -502,9 +507,11 @@ Result<void> merge(std::span<const ConstDepthPlane> ranges,
         const auto agrees = [low, span](std::uint16_t z) {
           return static_cast<std::uint32_t>(std::int32_t{z} - low) <= span;
         };
-        if (inner && mergeFullWindows({windows.data(), n}, k, low, span, o[x],
-                                      oc != nullptr ? ConfidenceAt{&confidenceRows, x, &oc[x]}
-                                                    : ConfidenceAt{})) {
+        // With the first value as the reference, decideChunk() has already tried this shortcut.
+        if (inner && ref != first &&
+            mergeFullWindows(
+                {windows.data(), n}, k, low, span, o[x],
+                oc != nullptr ? ConfidenceAt{&confidenceRows, x, &oc[x]} : ConfidenceAt{})) {
           continue;
         }
         const int x0 = x > 0 ? x - 1 : 0;
