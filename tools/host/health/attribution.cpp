@@ -45,7 +45,8 @@ std::expected<OwnedTriangulator, std::string> makeTriangulator(
   return OwnedTriangulator{std::move(memory), *triangulator};
 }
 
-// Per inlier block: the mean change of projector r's depth (mm) under each pose parameter.
+// Per inlier block: the mean change of projector r's depth under each pose parameter (mm at the
+// reference distance, as the disagreement).
 using Columns = std::vector<std::array<double, kPoseParameters>>;
 
 std::expected<Columns, std::string> poseColumns(const algo::Rig& rig, const CameraDepths& depths,
@@ -83,12 +84,13 @@ std::expected<Columns, std::string> poseColumns(const algo::Rig& rig, const Came
           const int z0 = base->triangulator.depthAt(x, y, stripe[i]);
           const int z1 = moved->triangulator.depthAt(x, y, stripe[i]);
           if (z0 != algo::kNoDepth && z1 != algo::kNoDepth) {
-            sum += z1 - z0;
+            sum +=
+                atReferenceDistance((z1 - z0) * depths.depthUnitM * 1000.0, z0 * depths.depthUnitM);
             ++n;
           }
         }
       }
-      columns[b][static_cast<std::size_t>(k)] = n > 0 ? sum / n * depths.depthUnitM * 1000.0 : 0.0;
+      columns[b][static_cast<std::size_t>(k)] = n > 0 ? sum / n : 0.0;
     }
   }
   return columns;

@@ -19,9 +19,11 @@ DisagreementField projectorPairField(const CameraDepths& d, int p, int q) {
   const auto& zp = d.depth[static_cast<std::size_t>(p)];
   const auto& zq = d.depth[static_cast<std::size_t>(q)];
   for (std::size_t i = 0; i < field.mm.size(); ++i) {
-    field.mm[i] = zp[i] == algo::kNoDepth || zq[i] == algo::kNoDepth
-                      ? std::numeric_limits<double>::quiet_NaN()
-                      : (static_cast<double>(zp[i]) - zq[i]) * d.depthUnitM * 1000.0;
+    field.mm[i] =
+        zp[i] == algo::kNoDepth || zq[i] == algo::kNoDepth
+            ? std::numeric_limits<double>::quiet_NaN()
+            : atReferenceDistance((static_cast<double>(zp[i]) - zq[i]) * d.depthUnitM * 1000.0,
+                                  0.5 * (zp[i] + zq[i]) * d.depthUnitM);
   }
   return field;
 }

@@ -70,7 +70,8 @@ DisagreementField crossCameraField(const algo::Rig& rig, const CameraDepths& fir
       const double z0 = algo::lens::toDevice(cam0, world)[2];
       const int u = static_cast<int>(std::lround(pixel->x));
       const int v = static_cast<int>(std::lround(pixel->y));
-      field.mm[first.index(u, v)] = (sampled * first.depthUnitM - z0) * 1000.0;
+      field.mm[first.index(u, v)] =
+          atReferenceDistance((sampled * first.depthUnitM - z0) * 1000.0, z0);
     }
   }
   return field;

@@ -1,9 +1,12 @@
 #include "smx/health/disagreement.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+
+#include "smx/health/chi_square_mix.hpp"
 
 namespace smx::health {
 
@@ -134,21 +137,32 @@ Disagreement fitDisagreement(const DisagreementField& field, const Thresholds& t
       return d;
     }
   }
-  double sumSquares = 0;
+  // The plane is judged over the whole image, not only over the compared blocks: a drift
+  // disturbs the rig's whole field of view, and a small object would otherwise hide a trend. With
+  // x, y uniform over [−1, 1]², the plane's mean square over the image is pᵀ·G·p, G = diag(1,
+  // 1/3, 1/3). Its noise: the fitted p has covariance σ²·A⁻¹ (A = Σ rᵀr over the inlier blocks,
+  // r = (1, x, y)), so pᵀ·G·p under pure noise is σ² times a sum of χ²₁ weighted by the
+  // eigenvalues of G^½·A⁻¹·G^½. Blocks over the whole image give A ≈ n·G: σ²·χ²₃/n.
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     if (use[i]) {
       d.inliers.push_back(blocks[i]);
-      const double v = plane[0] + plane[1] * blocks[i].x + plane[2] * blocks[i].y;
-      sumSquares += v * v;
+      const Eigen::Vector3d r(1.0, blocks[i].x, blocks[i].y);
+      a += r * r.transpose();
     }
   }
-  const auto n = static_cast<double>(d.inliers.size());
+  const Eigen::Vector3d gRoot(1.0, 1.0 / std::sqrt(3.0), 1.0 / std::sqrt(3.0));
+  const Eigen::Vector3d p(plane[0], plane[1], plane[2]);
+  const Eigen::Matrix3d spread = gRoot.asDiagonal() * a.inverse() * gRoot.asDiagonal();
+  const Eigen::Vector3d weights =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread, Eigen::EigenvaluesOnly).eigenvalues();
   d.offsetMm = plane[0];
   d.slopeXMm = plane[1];
   d.slopeYMm = plane[2];
   d.sigmaMm = sigma;
-  d.systematicMm = std::sqrt(sumSquares / n);
-  d.noiseMm = sigma * std::sqrt(thresholds.chiSquare / n);
+  d.systematicMm = gRoot.cwiseProduct(p).norm();
+  d.noiseMm = sigma * std::sqrt(weightedChiSquareQuantile({weights[0], weights[1], weights[2]},
+                                                          thresholds.falseAlarm));
   d.thresholdMm = d.noiseMm + thresholds.toleranceMm;
   d.enough = true;
   d.disagrees = d.systematicMm > d.thresholdMm;

@@ -14,17 +14,29 @@ struct Thresholds {
   int blockPx = 8;          // block side, camera pixels
   int minBlockPixels = 16;  // compared pixels a block needs for its median
   int minBlocks = 40;       // compared blocks a comparison needs ("not enough overlap" below)
-  // χ² with 3 degrees of freedom (the plane) at a false-alarm probability of 1e-4: pure noise
-  // gives a plane whose RMS over n blocks stays below σ·√(χ²/n).
-  double chiSquare = 21.1;
-  // The systematic disagreement accepted beyond the noise: half the smallest that a 1 mm or 0.2°
-  // projector drift causes on the example rigs (about 1 mm; docs/health.md), twice the
-  // largest that decoding leaves between correct calibrations (about 0.3 mm).
-  double toleranceMm = 0.5;
+  // The probability that noise alone exceeds the noise bound (the plane's mean square over the
+  // image beyond its 1 − falseAlarm quantile).
+  double falseAlarm = 1e-4;
+  // The systematic disagreement accepted beyond the noise (mm at the reference distance): half
+  // the smallest that a 1 mm or 0.2° projector drift causes on the example rigs and scenes
+  // (1.43 mm), above the largest that decoding leaves between correct calibrations (0.42 mm
+  // beyond the noise; docs/health-check.md).
+  double toleranceMm = 0.7;
 };
 
-// A disagreement image in metres-free form: per pixel of one camera image, mm, NaN where the two
-// measurements do not overlap.
+// Disagreements are compared as they would be at one reference distance. A projector that turns
+// moves its stripe planes by an angle, and the depth error that causes grows with z²; scaled by
+// (reference / z)², a turn disagrees alike on a near and a far scene, and one tolerance holds
+// for both. (A shift's error grows only with z: near scenes show it larger still.)
+constexpr double kReferenceDistanceM = 1.0;
+
+[[nodiscard]] inline double atReferenceDistance(double mm, double depthM) {
+  const double scale = kReferenceDistanceM / depthM;
+  return mm * scale * scale;
+}
+
+// A disagreement image: per pixel of one camera image, mm at the reference distance, NaN where
+// the two measurements do not overlap.
 struct DisagreementField {
   int width = 0;
   int height = 0;
