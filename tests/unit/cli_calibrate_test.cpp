@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration_floor.hpp"
 #include "cli_harness.hpp"
 #include "smx/algo/lens.hpp"
 #include "smx/algo/pattern_image.hpp"
@@ -312,6 +313,24 @@ TEST_F(CliCalibrate, GoodSetSolvesToTheTruth) {
   moved.t[0] += 0.001;  // the device's x axis is across the stripes (angle_deg 0)
   EXPECT_GT(plane(moved, 0), kPlaneRmsMm);
   EXPECT_GT(triangulation(moved, 0), kTriangulationRmsMm);
+}
+
+// The floor of the residual figures: the truth against the corners and stripes measured in the
+// captures is the measurement noise alone, small; a rig whose cam0 principal point is 2 px off,
+// or whose proj0 is 1 mm off across its stripes, fits the same measurements visibly worse.
+TEST_F(CliCalibrate, TheTruthFitsTheMeasurementsToTheirNoise) {
+  const algo::Rig truth = loadRig(captures() / "truth/rig.json");
+  const host::ResidualFloor floor = host::truthResiduals(captures(), truth);
+  EXPECT_GT(floor.cameraRmsPx, 0.0);
+  EXPECT_LT(floor.cameraRmsPx, 0.2);
+  EXPECT_GT(floor.projectorRmsPx, 0.0);
+  EXPECT_LT(floor.projectorRmsPx, 0.3);
+  algo::Rig shifted = truth;
+  shifted.cameras[0].K[2] += 2.0;
+  EXPECT_GT(host::truthResiduals(captures(), shifted).cameraRmsPx, 1.0);
+  algo::Rig moved = truth;
+  moved.projectors[0].t[0] += 0.001;  // across the stripes (angle_deg 0)
+  EXPECT_GT(host::truthResiduals(captures(), moved).projectorRmsPx, 2 * floor.projectorRmsPx);
 }
 
 TEST_F(CliCalibrate, FewerPosesThanTheMinimum) {

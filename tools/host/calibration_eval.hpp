@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration_floor.hpp"
 #include "smx/algo/rig.hpp"
 #include "smx/eval/depth_eval.hpp"
 
@@ -55,6 +56,7 @@ struct CalibrationCase {
   std::string failure;        // the solve's error; empty when it succeeded
   double cameraRmsPx = 0;     // largest over the cameras
   double projectorRmsPx = 0;  // largest over the projectors
+  ResidualFloor floor;        // the same figures for the real rig: the noise alone
   std::vector<DeviceError> cameras;
   std::vector<DeviceError> projectors;
   std::vector<SceneDepth> scenes;
