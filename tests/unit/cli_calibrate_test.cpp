@@ -315,6 +315,35 @@ TEST_F(CliCalibrate, GoodSetSolvesToTheTruth) {
   EXPECT_GT(triangulation(moved, 0), kTriangulationRmsMm);
 }
 
+// The depth scale's uncertainty the report gives (from the joint refinement's covariance) covers
+// the solved focal length's actual error, and is no larger than what the corners alone leave
+// (OpenCV's estimate): the stripes add measurements of the same target poses.
+TEST_F(CliCalibrate, TheReportedScaleUncertaintyCoversTheError) {
+  const fs::path out = dir_ / "rig.json";
+  const auto run =
+      test::runCli({"calibrate", "--rig", kRig.string(), "--captures", captures().string(), "--out",
+                    out.string(), "--report", (dir_ / "report").string()});
+  ASSERT_EQ(run.code, 0) << run.err;
+  const algo::Camera truth = loadRig(captures() / "truth/rig.json").cameras[0];
+  const algo::Camera solved = loadRig(out).cameras[0];
+  const Json camera = Json::parse(readText(dir_ / "report/report.json")).at("cameras").at(0);
+  const auto sdMm = camera.at("depth_scale_sd_mm_at_1m").get<double>();
+  const auto sdFx = camera.at("standard_deviation").at("fx").get<double>();
+  const double scaleErrorMm =
+      ((solved.fx() / truth.fx() + solved.fy() / truth.fy()) / 2 - 1) * 1000;
+  EXPECT_GT(sdMm, 0.0);
+  EXPECT_LT(std::abs(scaleErrorMm), 3 * sdMm);
+  // fx and fy move together, so the scale's sd is close to fx's relative sd.
+  EXPECT_NEAR(sdMm, sdFx / solved.fx() * 1000, 0.5 * sdMm);
+
+  const algo::Rig nominal = loadRig(kRig);
+  const auto set = calib::openCaptureSet(captures(), nominal);
+  ASSERT_TRUE(set.has_value()) << set.error();
+  const auto cornersAlone = calib::calibrateCameras(*set, nominal);
+  ASSERT_TRUE(cornersAlone.has_value()) << cornersAlone.error();
+  EXPECT_LE(sdFx, cornersAlone->cameras[0].sd[0] * 1.01);
+}
+
 // The floor of the residual figures: the truth against the corners and stripes measured in the
 // captures is the measurement noise alone, small; a rig whose cam0 principal point is 2 px off,
 // or whose proj0 is 1 mm off across its stripes, fits the same measurements visibly worse.

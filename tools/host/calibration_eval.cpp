@@ -68,9 +68,11 @@ void setPose(algo::DeviceModel& d, const Eigen::Matrix3d& rotation, const Eigen:
 // lens. Projector k1 stays within ±0.03: beyond about 0.05 the triangulation tables of these
 // rigs refuse the projector (docs/triangulation.md, the 0.1 mm fit).
 void perturb(algo::DeviceModel& d, Rng& rng, bool move, double k1Range) {
+  // Pixels are square to about 0.1 %: the aspect is taken before fx changes.
+  const double aspect = d.fy() / d.fx();
   const double fx = d.fx() * (1 + rng.uniform(-0.02, 0.02));
   d.K[0] = fx;
-  d.K[4] = fx * (d.fy() / d.fx()) * (1 + rng.uniform(-0.001, 0.001));
+  d.K[4] = fx * aspect * (1 + rng.uniform(-0.001, 0.001));
   d.K[2] += rng.uniform(-8, 8);
   d.K[5] += rng.uniform(-8, 8);
   d.dist[0] += rng.uniform(-k1Range, k1Range);
@@ -214,6 +216,7 @@ void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std:
                         DeviceError& error) {
   const algo::Camera& camera = real.cameras[0];
   double sum = 0;
+  double signedSum = 0;
   double worst = 0;
   int n = 0;
   constexpr int kStepPx = 16;
@@ -226,6 +229,7 @@ void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std:
         if (zc) {
           const double e = (*zc - z) * 1000;
           sum += e * e;
+          signedSum += e;
           worst = std::max(worst, std::abs(e));
           ++n;
         }
@@ -233,7 +237,43 @@ void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std:
     }
   }
   error.depthRmsMm = n > 0 ? std::sqrt(sum / n) : 0;
+  error.depthMeanMm = n > 0 ? signedSum / n : 0;
   error.depthMaxMm = worst;
+}
+
+fs::path renderCalibrationCaptures(const algo::Rig& real, int poses, std::uint64_t seed,
+                                   const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path realFile = dir / "real.json";
+  std::ofstream(realFile) << config::toJson(real);
+  fs::path captures = dir / "captures";
+  std::ostringstream out;
+  std::ostringstream err;
+  const std::vector<std::string> args = {
+      "sim",   "--rig",           realFile.string(), "--calibration", std::to_string(poses),
+      "--out", captures.string(), "--realism",       "--seed",        std::to_string(seed)};
+  if (runCli(args, {out, err}) != kExitOk) {
+    throw std::runtime_error("rendering " + std::to_string(poses) + " calibration poses into " +
+                             captures.string() + " failed: " + err.str());
+  }
+  return captures;
+}
+
+SceneDepth decodeWithBoth(const algo::Rig& real, const algo::Rig& calibrated,
+                          const std::string& scene, std::uint64_t seed) {
+  eval::SimRequest request;
+  request.seed = seed;
+  const eval::SimFrame frame = eval::renderSimFrame(real, eval::loadNamedScene(scene), request);
+  const eval::Mask region = eval::litRegion(frame, {.smooth = true});
+  const auto realRun = eval::runPipeline(frame, 0);
+  auto calRun = eval::makePipeline(calibrated, 0, eval::evalPipelineOptions());
+  if (!calRun->pipeline->run(frame.image.view())) {
+    throw std::runtime_error(scene + ": the calibrated rig's pipeline failed");
+  }
+  return {.scene = scene,
+          .real = eval::scoreMerged(frame, 0, *realRun->pipeline, region),
+          .calibrated = eval::scoreMerged(frame, 0, *calRun->pipeline, region)};
 }
 
 std::vector<CalibrationCase> runCalibrationEval(const CalibrationEvalOptions& options) {
@@ -249,29 +289,10 @@ std::vector<CalibrationCase> runCalibrationEval(const CalibrationEvalOptions& op
       const algo::Rig real = drawRealRig(nominal, options.seed * 1000 + r);
       const fs::path dir =
           options.work / (fs::path(c.rig).stem().string() + "-" + std::to_string(poses));
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-      const fs::path realFile = dir / "real.json";
-      std::ofstream(realFile) << config::toJson(real);
-      const fs::path captures = dir / "captures";
       if (options.progress) {
         options.progress(c.rig + ": rendering " + std::to_string(poses) + " poses");
       }
-      std::ostringstream out;
-      std::ostringstream err;
-      const std::vector<std::string> args = {"sim",
-                                             "--rig",
-                                             realFile.string(),
-                                             "--calibration",
-                                             std::to_string(poses),
-                                             "--out",
-                                             captures.string(),
-                                             "--realism",
-                                             "--seed",
-                                             std::to_string(options.seed + r)};
-      if (runCli(args, {out, err}) != kExitOk) {
-        throw std::runtime_error(c.rig + ": rendering the captures failed: " + err.str());
-      }
+      const fs::path captures = renderCalibrationCaptures(real, poses, options.seed + r, dir);
       c.floor = truthResiduals(captures, real);
       if (options.progress) {
         options.progress(c.rig + ": solving");
@@ -301,19 +322,7 @@ std::vector<CalibrationCase> runCalibrationEval(const CalibrationEvalOptions& op
         if (options.progress) {
           options.progress(c.rig + ": " + scene);
         }
-        eval::SimRequest request;
-        request.seed = options.seed;
-        const eval::SimFrame frame =
-            eval::renderSimFrame(real, eval::loadNamedScene(scene), request);
-        const eval::Mask region = eval::litRegion(frame, {.smooth = true});
-        const auto realRun = eval::runPipeline(frame, 0);
-        auto calRun = eval::makePipeline(solved->rig, 0, eval::evalPipelineOptions());
-        if (!calRun->pipeline->run(frame.image.view())) {
-          throw std::runtime_error(c.rig + ": " + scene + ": the calibrated rig's pipeline failed");
-        }
-        c.scenes.push_back({.scene = scene,
-                            .real = eval::scoreMerged(frame, 0, *realRun->pipeline, region),
-                            .calibrated = eval::scoreMerged(frame, 0, *calRun->pipeline, region)});
+        c.scenes.push_back(decodeWithBoth(real, solved->rig, scene, options.seed));
       }
       cases.push_back(std::move(c));
     }

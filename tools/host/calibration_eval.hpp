@@ -40,6 +40,7 @@ struct DeviceError {
   // Projectors: depth the calibrated rig triangulates from exact stripe coordinates, minus the
   // true depth, over cam0's image at 0.6–1.2 m: RMS and largest, mm.
   double depthRmsMm = 0;
+  double depthMeanMm = 0;  // signed: a scale error shows here
   double depthMaxMm = 0;
 };
 
@@ -73,6 +74,16 @@ struct CalibrationCase {
 // each rig.
 void measureStripeDepth(const algo::Rig& real, const algo::Rig& calibrated, std::size_t p,
                         DeviceError& error);
+
+// Renders `poses` calibration captures of the real rig with the realistic optics into
+// dir/captures (dir/real.json beside them) and returns that folder. Throws when it fails.
+[[nodiscard]] std::filesystem::path renderCalibrationCaptures(const algo::Rig& real, int poses,
+                                                              std::uint64_t seed,
+                                                              const std::filesystem::path& dir);
+
+// `scene` rendered with the real rig, decoded with each rig and scored.
+[[nodiscard]] SceneDepth decodeWithBoth(const algo::Rig& real, const algo::Rig& calibrated,
+                                        const std::string& scene, std::uint64_t seed);
 
 [[nodiscard]] std::vector<CalibrationCase> runCalibrationEval(
     const CalibrationEvalOptions& options);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calibration_eval.hpp"
+#include "calibration_spread.hpp"
 #include "commands.hpp"
 #include "eval_report.hpp"
 #include "output_folder.hpp"
@@ -100,13 +101,19 @@ int runCalibrationEval(const EvalOptions& o, const CliStreams& io) {
   options.progress = [&io](const std::string& line) { io.out << line << '\n' << std::flush; };
   try {
     const auto cases = runCalibrationEval(options);
+    SpreadOptions spread;
+    spread.seed = o.seed;
+    spread.work = options.work;
+    spread.progress = options.progress;
+    const auto runs = runCalibrationSpread(spread);
     auto out = OutputFolder::create(o.out);
     if (!out) {
       io.err << "stripemux eval: " << out.error() << '\n';
       return kExitDeviceOrIo;
     }
     if (auto ok =
-            out->writeText("calibration-results.md", calibrationMarkdown(cases, commandLine(o)));
+            out->writeText("calibration-results.md", calibrationMarkdown(cases, commandLine(o)) +
+                                                         spreadMarkdown(spread, runs));
         !ok || !out->commit()) {
       io.err << "stripemux eval: cannot write " << (o.out / "calibration-results.md").string()
              << '\n';

@@ -3,10 +3,12 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include "projector_model.hpp"
 #include "smx/algo/lens.hpp"
@@ -152,6 +154,101 @@ double rms(const std::vector<double>& values) {
   return values.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(values.size()));
 }
 
+// The solution's covariance, (JᵀJ)⁻¹ over the free parameters in their tangent spaces, from the
+// residuals' Jacobian at the solution. Ceres's own Covariance factors the whole Jacobian, which
+// for a hundred thousand stripe samples costs far more than the solve; JᵀJ is a few hundred wide.
+struct Covariance {
+  std::vector<double*> blocks;
+  std::vector<int> offsets;  // each block's first column
+  Eigen::MatrixXd matrix;
+
+  [[nodiscard]] int offsetOf(const double* block) const {
+    const auto at = std::ranges::find(blocks, block);
+    return at == blocks.end() ? -1 : offsets[static_cast<std::size_t>(at - blocks.begin())];
+  }
+};
+
+std::expected<Covariance, std::string> solutionCovariance(ceres::Problem& problem) {
+  Covariance out;
+  std::vector<double*> all;
+  problem.GetParameterBlocks(&all);
+  int columns = 0;
+  for (double* block : all) {
+    if (!problem.IsParameterBlockConstant(block)) {
+      out.blocks.push_back(block);
+      out.offsets.push_back(columns);
+      columns += problem.ParameterBlockTangentSize(block);
+    }
+  }
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = out.blocks;
+  options.num_threads = 2;
+  ceres::CRSMatrix jacobian;
+  if (!problem.Evaluate(options, nullptr, nullptr, nullptr, &jacobian)) {
+    return std::unexpected(std::string("the joint refinement's Jacobian could not be evaluated"));
+  }
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(columns, columns);
+  for (std::size_t r = 0; r + 1 < jacobian.rows.size(); ++r) {
+    const auto begin = static_cast<std::size_t>(jacobian.rows[r]);
+    const auto end = static_cast<std::size_t>(jacobian.rows[r + 1]);
+    for (std::size_t a = begin; a < end; ++a) {
+      for (std::size_t b = begin; b < end; ++b) {
+        normal(jacobian.cols[a], jacobian.cols[b]) += jacobian.values[a] * jacobian.values[b];
+      }
+    }
+  }
+  // The pseudo-inverse: a direction the data leave flat gets no variance rather than infinity.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(normal);
+  if (eigen.info() != Eigen::Success) {
+    return std::unexpected(std::string("the joint refinement's covariance could not be computed"));
+  }
+  const Eigen::VectorXd& values = eigen.eigenvalues();
+  const double floor = values.maxCoeff() * 1e-14;
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(columns);
+  for (int i = 0; i < columns; ++i) {
+    inverse[i] = values[i] > floor ? 1.0 / values[i] : 0.0;
+  }
+  out.matrix = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  return out;
+}
+
+// Each camera's standard deviations after the joint solve (its corners' own fit knew only the
+// corners), and the depth scale's uncertainty they imply.
+std::expected<void, std::string> cameraUncertainty(ceres::Problem& problem,
+                                                   const std::vector<CameraParams>& cams,
+                                                   CamerasFit& cameras) {
+  const auto covariance = solutionCovariance(problem);
+  if (!covariance) {
+    return std::unexpected(covariance.error());
+  }
+  const Eigen::MatrixXd& m = covariance->matrix;
+  for (std::size_t c = 0; c < cams.size(); ++c) {
+    CameraFit& fit = cameras.cameras[c];
+    fit.sd.fill(0.0);
+    const int k = covariance->offsetOf(cams[c].intrinsics.data());
+    if (k < 0) {
+      continue;
+    }
+    for (int i = 0; i < 4; ++i) {
+      fit.sd[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, m(k + i, k + i)));
+    }
+    // The lens block's tangent space leaves out k3 when it is held at the nominal.
+    if (const int l = covariance->offsetOf(cams[c].lens.data()); l >= 0) {
+      const int free = problem.ParameterBlockTangentSize(cams[c].lens.data());
+      for (int i = 0; i < free; ++i) {
+        fit.sd[4 + static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, m(l + i, l + i)));
+      }
+    }
+    // Depth scales with the focal length: the variance of (fx/f̂x + fy/f̂y)/2.
+    const double fx = cams[c].intrinsics[0];
+    const double fy = cams[c].intrinsics[1];
+    const double scaleVariance =
+        (m(k, k) / (fx * fx) + 2 * m(k, k + 1) / (fx * fy) + m(k + 1, k + 1) / (fy * fy)) / 4;
+    fit.depthScaleSdMm = std::sqrt(std::max(0.0, scaleVariance)) * 1000.0;
+  }
+  return {};
+}
+
 }  // namespace
 
 std::expected<JointFigures, std::string> refineJointly(
@@ -256,6 +353,10 @@ std::expected<JointFigures, std::string> refineJointly(
   figures.converged = summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) {
     return std::unexpected("the joint refinement failed: " + summary.message);
+  }
+
+  if (auto sd = cameraUncertainty(problem, cams, cameras); !sd) {
+    return std::unexpected(sd.error());
   }
 
   // Write back, then measure every residual again with the rig as it now is.

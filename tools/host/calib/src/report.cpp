@@ -46,6 +46,7 @@ Json reportJson(const Calibration& c) {
     cameras.push_back({{"id", fit.camera.id},
                        {"rms_px", rounded(fit.rmsPx, 1e-4)},
                        {"standard_deviation", std::move(sd)},
+                       {"depth_scale_sd_mm_at_1m", rounded(fit.depthScaleSdMm, 1e-3)},
                        {"fixed_at_nominal", fit.fixedAtNominal},
                        {"poses", std::move(poses)}});
   }
@@ -83,7 +84,8 @@ std::string reportText(const Calibration& c) {
     }
     s << fit.camera.id << ": reprojection RMS " << fixed(fit.rmsPx, 3) << " px over " << used
       << " of " << fit.poses.size() << " poses; focal length ±" << fixed(fit.sd[0], 2)
-      << " px, principal point ±" << fixed(std::max(fit.sd[2], fit.sd[3]), 2) << " px";
+      << " px, principal point ±" << fixed(std::max(fit.sd[2], fit.sd[3]), 2)
+      << " px; depth scale ±" << fixed(fit.depthScaleSdMm, 2) << " mm at 1 m";
     for (const PoseUse& use : fit.poses) {
       if (!use.used) {
         s << "\n  " << use.pose << ": " << use.note;

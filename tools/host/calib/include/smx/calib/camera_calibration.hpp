@@ -30,8 +30,11 @@ struct CameraFit {
   algo::Camera camera;
   double rmsPx = 0.0;  // over the corners of the poses used
   // Standard deviations of fx, fy, cx, cy (px) and k1, k2, p1, p2, k3 as the fit estimates them
-  // from the corners' scatter: how well the data determined each.
+  // from the measurements' scatter: how well the data determined each.
   std::array<double, 9> sd{};
+  // The standard deviation of the depth scale that the focal lengths' uncertainty implies, in mm
+  // at 1 m. Set by the joint refinement; 0 before it.
+  double depthScaleSdMm = 0.0;
   std::vector<PoseUse> poses;
   std::vector<std::string> fixedAtNominal;  // parameters the data did not determine
   // Per pose of the set: the target's corners found in this camera, in target order; empty where
