@@ -268,7 +268,8 @@ class CliCalibrate : public test::CliTest {
 // within a few tenths of a pixel; the stripe residual within the decoder's noise; the stripe
 // surfaces and the triangulated board within a millimetre: the principal point's own error
 // (about half a pixel from 7 poses) turns the world frame by about a milliradian, which is most
-// of the millimetre at the board's distance. A 1 mm move of a projector takes both past them.
+// of the millimetre at the board's distance. A 2 mm move of a projector takes both past them
+// (the solve's own error can lie along a 1 mm move and take a third of it back).
 constexpr double kCameraPx = 0.5;
 constexpr double kResidualPx = 0.25;
 constexpr double kPlaneRmsMm = 0.75;
@@ -276,7 +277,7 @@ constexpr double kTriangulationRmsMm = 1.0;
 
 // The solved rig against the truth it was rendered with, computed from the truth's board points
 // and the lens and stripe models only; the same checks fail against a truth with proj0 moved
-// 1 mm across its stripes.
+// 2 mm across its stripes.
 TEST_F(CliCalibrate, GoodSetSolvesToTheTruth) {
   const fs::path out = dir_ / "rig.json";
   const auto run =
@@ -310,9 +311,10 @@ TEST_F(CliCalibrate, GoodSetSolvesToTheTruth) {
     EXPECT_LT(triangulation(truth.projectors[p], p), kTriangulationRmsMm) << truth.projectors[p].id;
   }
   algo::Projector moved = truth.projectors[0];
-  moved.t[0] += 0.001;  // the device's x axis is across the stripes (angle_deg 0)
-  EXPECT_GT(plane(moved, 0), kPlaneRmsMm);
-  EXPECT_GT(triangulation(moved, 0), kTriangulationRmsMm);
+  moved.t[0] += 0.002;  // the device's x axis is across the stripes (angle_deg 0)
+  EXPECT_GT(plane(moved, 0), kPlaneRmsMm) << "against the truth: " << plane(truth.projectors[0], 0);
+  EXPECT_GT(triangulation(moved, 0), kTriangulationRmsMm)
+      << "against the truth: " << triangulation(truth.projectors[0], 0);
 }
 
 // The depth scale's uncertainty the report gives (from the joint refinement's covariance) covers
@@ -351,7 +353,9 @@ TEST_F(CliCalibrate, TheTruthFitsTheMeasurementsToTheirNoise) {
   const algo::Rig truth = loadRig(captures() / "truth/rig.json");
   const host::ResidualFloor floor = host::truthResiduals(captures(), truth);
   EXPECT_GT(floor.cameraRmsPx, 0.0);
-  EXPECT_LT(floor.cameraRmsPx, 0.2);
+  // The corner detector's precision on these captures, which the depth scale's follows: a
+  // refinement window of a quarter of the corner spacing gives 0.096 px here.
+  EXPECT_LT(floor.cameraRmsPx, 0.08);
   EXPECT_GT(floor.projectorRmsPx, 0.0);
   EXPECT_LT(floor.projectorRmsPx, 0.3);
   algo::Rig shifted = truth;
