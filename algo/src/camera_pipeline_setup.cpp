@@ -50,6 +50,12 @@ std::expected<CameraPipelineSetup, std::string> prepareCameraPipeline(
   setup.trust = options.trust;
   setup.trust.tolerance.minUnits =
       static_cast<int>(std::clamp(std::ceil(kGrossToleranceM / options.depthUnitM), 1.0, 65535.0));
+  // The working range: where the directions are predicted and a distorted projector's tables
+  // are fitted (triangulation.hpp).
+  setup.trust.nearUnits =
+      static_cast<int>(std::ceil(units(kFitNearFactor * options.nominalDepthM)));
+  setup.trust.farUnits =
+      static_cast<int>(std::floor(units(kWorkingRangeFactor * options.nominalDepthM)));
   return setup;
 }
 

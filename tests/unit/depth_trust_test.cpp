@@ -55,9 +55,11 @@ double medianWidthPx(const eval::SimFrame& f, int p) {
   return w[w.size() / 2];
 }
 
-// Triangulates the truth stripe coordinate of projector p and runs the trust filter on it:
-// per pixel 1 where a depth was kept, 0 where it was dropped, −1 where there was none.
-std::vector<int> trusted(const eval::SimFrame& f, int p, const DepthTrustParams& params) {
+// Triangulates the truth stripe coordinate of projector p, `levelError` stripes off in the
+// pixels `wrong` marks, and runs the trust filter on it: per pixel 1 where a depth was kept, 0
+// where it was dropped, −1 where there was none.
+std::vector<int> trusted(const eval::SimFrame& f, int p, const DepthTrustParams& params,
+                         int levelError = 0, const std::vector<bool>& wrong = {}) {
   auto tables = buildTriangulationTables(f.rig, 0, p, kDefaultDepthUnitM);
   EXPECT_TRUE(tables) << tables.error();
   const int w = f.image.width;
@@ -66,7 +68,12 @@ std::vector<int> trusted(const eval::SimFrame& f, int p, const DepthTrustParams&
   Arena arena(memory);
   auto t = Triangulator::create(*tables, arena);
   EXPECT_TRUE(t);
-  const auto s = truthStripe(f, p);
+  auto s = truthStripe(f, p);
+  for (std::size_t i = 0; i < wrong.size(); ++i) {
+    if (wrong[i] && s[i] != kNoStripe) {
+      s[i] = std::clamp(s[i] + levelError * kStripeOne, 0, Triangulator::kMaxStripe - 1);
+    }
+  }
   std::vector<std::uint16_t> z(s.size());
   std::vector<std::uint8_t> c(s.size());
   const auto stripe = *ConstStripePlane::packed(s, w, h);
@@ -274,6 +281,60 @@ TEST(DepthTrust, MergedConfidenceFollowsTheTrueError) {
   }
 }
 
+// Every 6-transition window of the pattern is valid (docs/pattern.md), so a misread one decodes
+// to a level far from the true one; on the realism suite most such depths land below half the
+// true depth. On this rig, with its wide baseline, the plane lies about 100 stripes of disparity
+// from proj0: a patch decoded 60 stripes off towards the far side leaves the working range
+// (0.45–1.8 m) and is dropped, while without the range (the trust filter's defaults) it stays;
+// 30 stripes off either way stays inside the range and is kept: the range is no check of the
+// level itself, only of where the depth lands.
+TEST(DepthTrust, AStripeLevelFarOffFallsOutsideTheWorkingRange) {
+  const auto rig = eval::loadExampleRig("rig_2proj_1cam.json");
+  const auto f = eval::renderSimFrame(rig, eval::loadNamedScene("plane"));
+  PipelineOptions options;
+  options.nominalDepthM = 0.9;
+  const auto setup = prepareCameraPipeline(rig, 0, options);
+  ASSERT_TRUE(setup) << setup.error();
+  EXPECT_EQ(setup->trust.nearUnits, 4500);
+  EXPECT_EQ(setup->trust.farUnits, 18000);
+  const int w = f.image.width;
+  std::vector<bool> patch(f.stripe.at(0).pixels.size());
+  for (std::size_t i = 0; i < patch.size(); ++i) {
+    const int x = static_cast<int>(i) % w;
+    const int y = static_cast<int>(i) / w;
+    patch[i] = std::abs(x - w / 2) < 60 && std::abs(y - f.image.height / 2) < 60;
+  }
+  const auto share = [&](const std::vector<int>& kept) {
+    int inPatch = 0;
+    int stay = 0;
+    int outsideDropped = 0;
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      if (patch[i] && kept[i] >= 0) {
+        ++inPatch;
+        stay += kept[i];
+      } else if (!patch[i] && kept[i] == 0) {
+        ++outsideDropped;
+      }
+    }
+    EXPECT_GT(inPatch, 10000);
+    return std::pair{static_cast<double>(stay) / inPatch, outsideDropped};
+  };
+  for (const int levelError : {60, 30, -30}) {
+    SCOPED_TRACE(levelError);
+    const auto [ranged, rangedLost] = share(trusted(f, 0, setup->trust, levelError, patch));
+    const auto [unranged, unrangedLost] = share(trusted(f, 0, {}, levelError, patch));
+    std::printf("%+d stripes: %.4f of the patch kept in the working range, %.4f without\n",
+                levelError, ranged, unranged);
+    EXPECT_GE(unranged, 0.9);
+    if (levelError == 60) {
+      EXPECT_LE(ranged, 0.01);
+    } else {
+      EXPECT_EQ(ranged, unranged);
+    }
+    EXPECT_EQ(rangedLost, unrangedLost) << "the plane itself lies inside the range";
+  }
+}
+
 TEST(DepthTrust, RejectsParametersNamingTheField) {
   const auto message = [](DepthTrustParams p) {
     auto r = validateDepthTrust(p);
@@ -295,6 +356,13 @@ TEST(DepthTrust, RejectsParametersNamingTheField) {
   p = {};
   p.tolerance.permille = 1001;
   EXPECT_NE(message(p).find("tolerance.permille"), std::string::npos);
+  p = {};
+  p.nearUnits = 0;
+  EXPECT_NE(message(p).find("working range"), std::string::npos);
+  p = {};
+  p.nearUnits = 2000;
+  p.farUnits = 1999;
+  EXPECT_NE(message(p).find("working range"), std::string::npos);
 }
 
 }  // namespace

@@ -429,6 +429,20 @@ TEST(TriangulationWithTrust, OnePassGivesTheReferenceOnRandomStripes) {
     variants[4].boundaryErrorQ8 = 256;
     variants[4].errorMargin = 10;
     variants[5].tolerance = {1, 0};
+    // A working range around the middle half of the depths the defaults keep: its limits cut
+    // through the surface, so both sides of each are met.
+    {
+      std::vector<std::uint16_t> z(stripe.size());
+      std::vector<std::uint8_t> c(stripe.size());
+      ASSERT_TRUE(triangulateTrusted(*t, stripePlane, *DepthPlane::packed(z, w, h),
+                                     *ImageView<std::uint8_t>::packed(c, w, h), defaults));
+      std::erase(z, kNoDepth);
+      ASSERT_GT(z.size(), stripe.size() / 4);
+      std::ranges::sort(z);
+      variants.push_back(defaults);
+      variants.back().nearUnits = z[z.size() / 4];
+      variants.back().farUnits = z[3 * z.size() / 4];
+    }
     for (std::size_t v = 0; v < variants.size(); ++v) {
       SCOPED_TRACE((distorted ? "distorted, parameters " : "undistorted, parameters ") +
                    std::to_string(v));
@@ -451,6 +465,12 @@ TEST(TriangulationWithTrust, OnePassGivesTheReferenceOnRandomStripes) {
                                       [](std::uint16_t z) { return z != kNoDepth; });
       if (v == 0 || v == 1 || v == 3) {  // the others keep (next to) nothing by design
         EXPECT_GT(kept, w * h / 4);
+      }
+      if (v == 6) {  // half the depths, and none outside the range
+        EXPECT_GT(kept, w * h / 8);
+        for (const std::uint16_t z : depthReference) {
+          EXPECT_TRUE(z == kNoDepth || (z >= variants[v].nearUnits && z <= variants[v].farUnits));
+        }
       }
     }
     std::vector<std::uint16_t> small(static_cast<std::size_t>((w - 1) * h));

@@ -278,8 +278,10 @@ void addDecodeCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       ->required();
   cmd->add_option("--debug", opts->debug,
                   "Write per projector and camera: stripe segmentation, decoded stripes, depth");
-  cmd->add_option("--nominal-depth", opts->nominalDepthM,
-                  "Depth (m) at which the rig predicts the pattern directions")
+  cmd->add_option(
+         "--nominal-depth", opts->nominalDepthM,
+         "Depth (m) at which the rig predicts the pattern directions; depth is kept from half "
+         "to twice it")
       ->check(CLI::Range(0.05, 100.0));
   cmd->add_option("--depth-unit", opts->depthUnitM,
                   "Metres per unit of the 16-bit depth images (default 0.0001)")

@@ -49,6 +49,10 @@ Result<void> validateDepthTrust(const DepthTrustParams& p) {
   if (p.tolerance.permille < 0 || p.tolerance.permille > 1000) {
     return fail(Errc::kInvalidArgument, "trust: tolerance.permille must be 0 to 1000");
   }
+  if (p.nearUnits < 1 || p.farUnits < p.nearUnits || p.farUnits > 65535) {
+    return fail(Errc::kInvalidArgument,
+                "trust: the working range needs 1 <= nearUnits <= farUnits <= 65535");
+  }
   return {};
 }
 

@@ -20,6 +20,8 @@
 //     (Triangulator::depthAt once more: exact for the tables; the central difference would
 //     differ only in second order), kept when errorMargin · e ≤ tol(z),
 //     tol(z) = max(minUnits, permille ‰ of z), the gross tolerance;
+//   - within the rig's working range: nearUnits ≤ z ≤ farUnits (a wrong stripe level moves the
+//     depth by many stripes, mostly far out of it);
 //   - confidence 255 · (1 − errorMargin · e / tol(z)), clamped to 1…255 (0: no depth).
 // The defaults and where they come from: docs/decode.md, "Trust and confidence".
 //
@@ -46,6 +48,10 @@ struct DepthTrustParams {
   int minStripeWidthQ8 = 640;  // 2.5 px: narrower stripes are not separated by the detector
   int errorMargin = 2;         // 2δ (≥ 3σ as measured) stays inside the tolerance
   DepthTolerance tolerance;
+  // The working range in depth units; prepareCameraPipeline sets it to kFitNearFactor …
+  // kWorkingRangeFactor times the nominal depth. The defaults keep every depth.
+  int nearUnits = 1;
+  int farUnits = 65535;
 };
 
 // Range-checks the parameters; errors name the field.

@@ -17,6 +17,9 @@ namespace smx::algo {
 
 // The confidence of a depth z with predicted error spread / 2, or 0 when it is not trusted.
 inline std::uint8_t confidenceOf(std::int64_t spread, std::int32_t z, const DepthTrustParams& p) {
+  if (z < p.nearUnits || z > p.farUnits) {
+    return 0;
+  }
   const std::int64_t tol2 = 2 * std::int64_t{p.tolerance.at(z)};
   const std::int64_t scaled = spread * p.errorMargin;
   if (scaled > tol2) {
