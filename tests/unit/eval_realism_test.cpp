@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <numbers>
@@ -19,6 +20,7 @@
 #include "smx/eval/realism_case.hpp"
 #include "smx/eval/realism_eval.hpp"
 #include "smx/eval/suite.hpp"
+#include "smx/eval/wrong_depth.hpp"
 
 namespace smx::eval {
 namespace {
@@ -432,6 +434,66 @@ TEST(RealismAttribution, SumsAddTheCounts) {
 // regression guards, not the targets (gross outside the band ≤ 0.1 %, resolvable
 // completeness ≥ 95 %, quoted in docs/results.md): measured 0.12 % and 90.0 % with the trust
 // filter's working range, with a margin of 0.08 and 2 points. Raise them as the pipeline improves.
+// Six pixels in a row, the truth 1 m deep with projector 0's stripe coordinate 50 + x and
+// projector 1's 80 + x (unlit at x = 4): each gross pixel of the region goes to one kind, by the
+// first projector with depth there.
+TEST(WrongDepthKinds, EachGrossPixelIsCountedOnceByItsKind) {
+  constexpr int kW = 6;
+  constexpr double kUnitM = 1e-4;
+  const auto q16 = [](double s) { return static_cast<algo::StripeQ16>(std::lround(s * 65536)); };
+  std::vector<OwnedPlane<float>> truthStripes{OwnedPlane<float>(kW, 1, 0.0F),
+                                              OwnedPlane<float>(kW, 1, 0.0F)};
+  const OwnedPlane<float> truthDepth(kW, 1, 1.0F);
+  std::vector<std::vector<algo::StripeQ16>> s(2, std::vector<algo::StripeQ16>(kW, algo::kNoStripe));
+  std::vector<std::vector<std::uint16_t>> z(2, std::vector<std::uint16_t>(kW, algo::kNoDepth));
+  std::vector<std::uint16_t> merged(kW, algo::kNoDepth);
+  for (int x = 0; x < kW; ++x) {
+    truthStripes[0].pixels[static_cast<std::size_t>(x)] = 50.0F + static_cast<float>(x);
+    truthStripes[1].pixels[static_cast<std::size_t>(x)] = 80.0F + static_cast<float>(x);
+  }
+  truthStripes[1].pixels[4] = std::numeric_limits<float>::quiet_NaN();
+  const auto put = [&](int p, int x, double stripeError, std::uint16_t depth) {
+    const auto i = static_cast<std::size_t>(x);
+    s[static_cast<std::size_t>(p)][i] =
+        q16(truthStripes[static_cast<std::size_t>(p)].pixels[i] + stripeError);
+    z[static_cast<std::size_t>(p)][i] = depth;
+  };
+  put(0, 0, 0.0, 10000);  // right: not counted
+  merged[0] = 10000;
+  put(0, 1, 3.0, 9000);  // 10 cm off, three stripes: level, alone
+  merged[1] = 9000;
+  put(0, 2, 0.3, 10300);  // 3 cm off, a third of a stripe, with projector 1: position, corroborated
+  put(1, 2, 0.3, 10300);
+  merged[2] = 10300;
+  z[1][4] = 8000;  // projector 1 alone where it does not light: unlit
+  merged[4] = 8000;
+  put(0, 5, 0.6, 11000);  // level, alone, but outside the region
+  merged[5] = 11000;
+  Mask region = Mask::filled(kW, 1, 255);
+  region.at(5, 0) = 0;
+  std::vector<algo::ConstStripePlane> stripes;
+  std::vector<algo::ConstDepthPlane> depths;
+  for (std::size_t p = 0; p < 2; ++p) {
+    stripes.push_back(*algo::ConstStripePlane::packed(s[p], kW, 1));
+    depths.push_back(*algo::ConstDepthPlane::packed(z[p], kW, 1));
+  }
+  const WrongDepth w = classifyWrongDepth(stripes, depths, truthStripes,
+                                          *algo::ConstDepthPlane::packed(merged, kW, 1),
+                                          truthDepth.view(), region, kUnitM);
+  const auto at = [&w](int corroborated, WrongKind k) {
+    return w.gross[static_cast<std::size_t>(corroborated)][static_cast<std::size_t>(k)];
+  };
+  EXPECT_EQ(at(0, WrongKind::kLevel), 1);
+  EXPECT_EQ(at(1, WrongKind::kPosition), 1);
+  EXPECT_EQ(at(0, WrongKind::kUnlit), 1);
+  EXPECT_EQ(w.total(), 3);
+  const std::vector<WrongDepth> twice{w, w};
+  EXPECT_EQ(sumWrongDepth(twice).total(), 6);
+  EXPECT_EQ(sumWrongDepth(twice).gross[1][static_cast<std::size_t>(WrongKind::kPosition)], 2);
+  EXPECT_STREQ(wrongKindName(WrongKind::kLevel), "level");
+  EXPECT_STREQ(wrongKindName(WrongKind::kUnlit), "unlit");
+}
+
 TEST(RealismSuite, FixedSeedSubsetStaysWithinItsGuards) {
   SuiteOptions o;
   o.seed = kSeed;

@@ -1,5 +1,6 @@
 #include "eval_report.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <ostream>
 #include <set>
 #include <sstream>
+#include <string>
 #include <system_error>
 #include <vector>
 
@@ -483,6 +485,50 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
      << pct(eval::completenessWithout(sum, eval::Cause::kOther)) << " |\n\n";
 }
 
+void wrongDepthSection(std::ostream& md, const eval::RealismReport& s) {
+  std::vector<eval::WrongDepth> all;
+  for (const auto& run : s.runs) {
+    if (!run.refused) {
+      all.push_back(run.wrongDepth);
+    }
+  }
+  const auto sum = eval::sumWrongDepth(all);
+  const int total = sum.total();
+  const auto cell = [total](int n) {
+    return std::to_string(n) + " (" + pct(total > 0 ? static_cast<double>(n) / total : 0.0) + ")";
+  };
+  md << "### What the wrong depths are\n\n"
+        "Each gross pixel outside the band, judged against the truth stripe coordinate of the "
+        "first projector with depth there (`tools/host/eval/include/smx/eval/wrong_depth.hpp`): "
+        "**level** its decoded coordinate is "
+     << fixed(eval::kLevelErrorStripes, 1)
+     << " stripe or more off (a wrong stripe level), **position** less (the right level, its "
+        "boundaries misplaced), **unlit** that projector does not light the pixel; **alone** no "
+        "other projector has depth there, **corroborated** others do. Pixels and shares of all "
+        "the gross pixels outside the band.\n\n| depth from";
+  for (int k = 0; k < eval::kWrongKinds; ++k) {
+    md << " | " << eval::wrongKindName(static_cast<eval::WrongKind>(k));
+  }
+  md << " | all |\n|---|---|---|---|---|\n";
+  const char* names[] = {"alone", "corroborated"};
+  std::array<int, eval::kWrongKinds> kinds{};
+  for (std::size_t a = 0; a < sum.gross.size(); ++a) {
+    int row = 0;
+    md << "| " << names[a];
+    for (std::size_t k = 0; k < kinds.size(); ++k) {
+      md << " | " << cell(sum.gross[a][k]);
+      row += sum.gross[a][k];
+      kinds[k] += sum.gross[a][k];
+    }
+    md << " | " << cell(row) << " |\n";
+  }
+  md << "| all";
+  for (const int k : kinds) {
+    md << " | " << cell(k);
+  }
+  md << " | " << cell(total) << " |\n\n";
+}
+
 void realismSection(Writer& w, const eval::Report& r) {
   const auto& s = r.realism;
   if (s.runs.empty()) {
@@ -567,6 +613,7 @@ void realismSection(Writer& w, const eval::Report& r) {
      << "| runs refused by the pipeline | " << refused << " of " << s.runs.size()
      << " | | | | |\n\n";
   attributionSection(md, s);
+  wrongDepthSection(md, s);
 
   md << "### Per run\n\n"
         "Rig: per projector the baseline to this camera, its encoding axis in cam0 and the "

@@ -149,6 +149,14 @@ std::vector<RealismRun> runRealismCase(const RealismCase& c, std::uint64_t seed,
     r.resolvable = scoreMerged(f, cam, pipe, resolvable);
     r.outsideBand = scoreMerged(f, cam, pipe, outsideBand);
     r.attribution = attributeRun(f, cam, pipe.merged(), outsideBand, resolvable);
+    std::vector<algo::ConstStripePlane> stripes;
+    std::vector<algo::ConstDepthPlane> depths;
+    for (int p = 0; p < pipe.projectors(); ++p) {
+      stripes.push_back(pipe.stripe(p));
+      depths.push_back(pipe.depth(p));
+    }
+    r.wrongDepth = classifyWrongDepth(stripes, depths, f.stripe, pipe.merged(), f.depth.view(),
+                                      outsideBand, options.depthUnitM);
     for (int p = 0; p < r.projectors; ++p) {
       r.medianStripePx.push_back(medianStripeWidthPx(f, p));
     }

@@ -11,6 +11,7 @@
 #include "smx/eval/realism_attribution.hpp"
 #include "smx/eval/realism_case.hpp"
 #include "smx/eval/sim_frame.hpp"
+#include "smx/eval/wrong_depth.hpp"
 
 // The realism suite's scoring (`stripemux eval --only realism`, docs/results.md): each camera of
 // a generated case (realism_case.hpp) rendered, decoded by the firmware's camera pipeline (its
@@ -49,6 +50,7 @@ struct RealismRun {
   DepthScore outsideBand;
   std::vector<double> medianStripePx;  // per projector, over the pixels it lights (truth)
   Attribution attribution;             // what stops the targets (realism_attribution.hpp)
+  WrongDepth wrongDepth;               // the gross pixels outside the band (wrong_depth.hpp)
 
   // Kept for the worst cases only (keepWorstImages): the camera image and merged − truth, mm.
   OwnedPlane<algo::Rgb8> image;
