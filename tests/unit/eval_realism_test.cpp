@@ -428,12 +428,6 @@ TEST(RealismAttribution, SumsAddTheCounts) {
   EXPECT_NEAR(grossRateWithout(s, Cause::kSingle), 23.0 / 101.0, 1e-12);
 }
 
-// The fixed-seed CI subset: the first 12 cases as `stripemux eval --only realism` renders them
-// (640 × 480 cameras, projector lens distortion, the simulator's real optics; smaller cameras
-// would shrink the stripes below what the product's envelope promises). The limits are
-// regression guards, not the targets (gross outside the band ≤ 0.1 %, resolvable
-// completeness ≥ 95 %, quoted in docs/results.md): measured 0.12 % and 90.0 % with the trust
-// filter's working range, with a margin of 0.08 and 2 points. Raise them as the pipeline improves.
 // Six pixels in a row, the truth 1 m deep with projector 0's stripe coordinate 50 + x and
 // projector 1's 80 + x (unlit at x = 4): each gross pixel of the region goes to one kind, by the
 // first projector with depth there.
@@ -494,6 +488,12 @@ TEST(WrongDepthKinds, EachGrossPixelIsCountedOnceByItsKind) {
   EXPECT_STREQ(wrongKindName(WrongKind::kUnlit), "unlit");
 }
 
+// The fixed-seed CI subset: the first 12 cases as `stripemux eval --only realism` renders them
+// (640 × 480 cameras, projector lens distortion, the simulator's real optics; smaller cameras
+// would shrink the stripes below what the product's envelope promises). The limits are
+// regression guards, not the targets (gross outside the band ≤ 0.1 %, resolvable
+// completeness ≥ 95 %, quoted in docs/results.md): measured 0.12 % and 90.0 % with the trust
+// filter's working range, with a margin of 0.08 and 2 points. Raise them as the pipeline improves.
 TEST(RealismSuite, FixedSeedSubsetStaysWithinItsGuards) {
   SuiteOptions o;
   o.seed = kSeed;

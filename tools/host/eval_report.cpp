@@ -437,14 +437,20 @@ std::string attributionRow(const std::string& head, const eval::Attribution& a) 
          " |\n";
 }
 
-void attributionSection(std::ostream& md, const eval::RealismReport& s) {
-  std::vector<eval::Attribution> all;
+// One field of every run the pipeline did not refuse.
+template <class T>
+std::vector<T> ofScoredRuns(const eval::RealismReport& s, T eval::RealismRun::*field) {
+  std::vector<T> out;
   for (const auto& run : s.runs) {
     if (!run.refused) {
-      all.push_back(run.attribution);
+      out.push_back(run.*field);
     }
   }
-  const auto sum = eval::sumAttributions(all);
+  return out;
+}
+
+void attributionSection(std::ostream& md, const eval::RealismReport& s) {
+  const auto sum = eval::sumAttributions(ofScoredRuns(s, &eval::RealismRun::attribution));
   md << "### What stops the targets\n\n"
         "Each gross pixel outside the band and each resolvable pixel without depth goes to the "
         "first condition it meets, all from the truth and the camera image, never from the "
@@ -486,13 +492,7 @@ void attributionSection(std::ostream& md, const eval::RealismReport& s) {
 }
 
 void wrongDepthSection(std::ostream& md, const eval::RealismReport& s) {
-  std::vector<eval::WrongDepth> all;
-  for (const auto& run : s.runs) {
-    if (!run.refused) {
-      all.push_back(run.wrongDepth);
-    }
-  }
-  const auto sum = eval::sumWrongDepth(all);
+  const auto sum = eval::sumWrongDepth(ofScoredRuns(s, &eval::RealismRun::wrongDepth));
   const int total = sum.total();
   const auto cell = [total](int n) {
     return std::to_string(n) + " (" + pct(total > 0 ? static_cast<double>(n) / total : 0.0) + ")";
