@@ -290,6 +290,8 @@ host::CaptureGuideOptions guideOptions(int poses) {
   options.rows = kGuideTarget.rows;
   options.squareM = kGuideTarget.squareM;
   options.poseTimeout = 20s;
+  // A raw capture is a render: under ASan, beside another rendering test, it can pass 10 s.
+  options.captureTimeout = 60s;
   return options;
 }
 
