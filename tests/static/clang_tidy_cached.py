@@ -3,9 +3,11 @@
 analysis found nothing and whose inputs have not changed since.
 
 A unit's inputs are hashed into its cache key:
-  - its preprocessed text (clang -E -C: every header it includes, and the comments, so that a
-    NOLINT removed from a header is seen), with the source and build folders' paths replaced by
-    placeholders so that a clone elsewhere shares the cache;
+  - the text of every file it includes, comments and all (so that a NOLINT removed from a header
+    is seen): read from the files its build's dependency file lists (OBJECT.d, written by the
+    compiler beside the object) when that file is newer than each file it lists; otherwise its
+    preprocessed text (clang -E -C), which costs a second or more per unit. The source and build
+    folders' paths are replaced by placeholders so that a clone elsewhere shares the cache;
   - its compile command (flags decide which compiler warnings clang-tidy reports) and its path
     relative to the source folder (HeaderFilterRegex matches paths);
   - the text of every .clang-tidy file of the source tree, the extra arguments, and the
@@ -33,12 +35,13 @@ import json
 import os
 import pathlib
 import shlex
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
 
-KEY_FORMAT = b"stripemux-tidy-cache/1\n"
+KEY_FORMAT = b"stripemux-tidy-cache/2\n"
 
 
 def default_cache():
@@ -48,8 +51,22 @@ def default_cache():
     return pathlib.Path(base) / "stripemux" / "clang-tidy"
 
 
-def tool_version(binary):
-    return subprocess.run([binary, "--version"], check=True, capture_output=True).stdout
+def tool_version(binary, cache):
+    """What BINARY --version prints, kept in CACHE by the binary's path, size and time: each
+    unit's run is a process of its own, and asking both tools costs a quarter of a second."""
+    stat = pathlib.Path(shutil.which(binary) or binary).resolve().stat()
+    name = hashlib.sha256(f"{binary}\0{stat.st_size}\0{stat.st_mtime_ns}".encode()).hexdigest()
+    stored = cache / "versions" / name
+    try:
+        return stored.read_bytes()
+    except OSError:
+        pass
+    version = subprocess.run([binary, "--version"], check=True, capture_output=True).stdout
+    stored.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.NamedTemporaryFile("wb", dir=stored.parent, delete=False) as tmp:
+        tmp.write(version)
+    os.replace(tmp.name, stored)
+    return version
 
 
 def tidy_configs(source_root):
@@ -101,15 +118,53 @@ class Unit:
 
     def key(self, common, clang, extra_args):
         args = command_args(self.entry)
+        digest = hashlib.sha256(common)
+        digest.update(self.relative.encode() + b"\0")
+        digest.update(self.normalise(" ".join(args).encode()) + b"\0")
+        inputs = self.included_files(args)
+        if inputs is not None:
+            digest.update(b"included files\0")
+            for path in inputs:
+                digest.update(self.normalise(str(path).encode()) + b"\0")
+                digest.update(self.normalise(path.read_bytes()) + b"\0")
+            return digest.hexdigest()
         result = subprocess.run(preprocess_args(args, clang, extra_args),
                                 cwd=self.entry["directory"], capture_output=True)
         if result.returncode != 0:
             return None  # let clang-tidy report why it cannot parse the unit
-        digest = hashlib.sha256(common)
-        digest.update(self.relative.encode() + b"\0")
-        digest.update(self.normalise(" ".join(args).encode()) + b"\0")
+        digest.update(b"preprocessed\0")
         digest.update(self.normalise(result.stdout))
         return digest.hexdigest()
+
+    def included_files(self, args):
+        """The files the last compile of the unit read, from its dependency file, sorted; None
+        when there is none or it is older than one of them (edited since: a build is due)."""
+        try:
+            output = args[args.index("-o") + 1]
+        except (ValueError, IndexError):
+            return None
+        depfile = pathlib.Path(self.entry["directory"], output + ".d")
+        try:
+            written = depfile.stat().st_mtime_ns
+            text = depfile.read_text()
+        except OSError:
+            return None
+        # "object: dep dep \" lines; a path's own spaces are escaped with a backslash.
+        words = text.replace("\\\n", " ").replace("\\ ", "\0").split()
+        paths = set()
+        for word in words:
+            if word.endswith(":"):
+                continue
+            path = pathlib.Path(self.entry["directory"], word.replace("\0", " ")).resolve()
+            try:
+                if path.stat().st_mtime_ns > written:
+                    return None
+            except OSError:
+                return None
+            paths.add(path)
+        if pathlib.Path(self.path).resolve() not in paths:
+            return None
+        return sorted(paths)
 
 
 def read_known_clean(path):
@@ -181,8 +236,9 @@ def main(argv):
             return 2
         units.append(Unit(path, entries[path], options.build, options.source_root))
     try:
-        common = hashlib.sha256(KEY_FORMAT + tool_version(options.clang_tidy) +
-                                tool_version(options.clang) + tidy_configs(options.source_root) +
+        common = hashlib.sha256(KEY_FORMAT + tool_version(options.clang_tidy, options.cache) +
+                                tool_version(options.clang, options.cache) +
+                                tidy_configs(options.source_root) +
                                 "\0".join(options.extra_arg).encode()).digest()
     except (OSError, subprocess.CalledProcessError) as error:
         print(f"clang-tidy: {error}", file=sys.stderr)

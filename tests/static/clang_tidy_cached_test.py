@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """The clang-tidy cache never hides a finding: a unit with a finding fails on every run, and any
 change to what clang-tidy reads (a header, a NOLINT comment, the configuration, the flags) is
-analysed again; an unchanged unit, also in a clone at another path, is not.
+analysed again; an unchanged unit, also in a clone at another path, is not. A built unit is keyed
+by the files its dependency file lists, without preprocessing, unless one was edited after it.
 
 Usage: clang_tidy_cached_test.py CLANG_TIDY CLANG SOURCE_ROOT
 """
 import json
+import os
 import pathlib
 import shutil
 import subprocess
@@ -63,10 +65,23 @@ class ClangTidyCacheTest(unittest.TestCase):
         }]
         (root / "build" / "compile_commands.json").write_text(json.dumps(database))
 
-    def run_cached(self, tree=None, options=()):
+    def compile(self, tree=None):
+        """Builds the unit as the build does, writing build/unit.o.d beside the object."""
+        tree = tree or self.tree
+        unit = str(tree / "algo" / "unit.cpp")
+        subprocess.run([CLANG, "-std=c++2b", "-MD", "-MF", "unit.o.d", "-o", "unit.o", "-c", unit],
+                       cwd=tree / "build", check=True)
+
+    def clang_that_cannot_preprocess(self):
+        fake = self.tmp / "fake-clang"
+        fake.write_text('#!/bin/sh\n[ "$1" = --version ] && echo "fake clang" && exit 0\nexit 1\n')
+        fake.chmod(0o755)
+        return str(fake)
+
+    def run_cached(self, tree=None, options=(), clang=None):
         tree = tree or self.tree
         result = subprocess.run(
-            [sys.executable, str(SCRIPT), "--clang-tidy", CLANG_TIDY, "--clang", CLANG,
+            [sys.executable, str(SCRIPT), "--clang-tidy", CLANG_TIDY, "--clang", clang or CLANG,
              "--build", str(tree / "build"), "--source-root", str(tree),
              "--cache", str(self.cache), "--extra-arg=-std=c++2b", *options, "algo/unit.cpp"],
             capture_output=True, text=True)
@@ -75,8 +90,8 @@ class ClangTidyCacheTest(unittest.TestCase):
     def set_helper(self, text):
         (self.tree / "algo" / "helper.hpp").write_text(text)
 
-    def assert_status(self, status, tree=None, options=()):
-        code, output = self.run_cached(tree, options)
+    def assert_status(self, status, tree=None, options=(), clang=None):
+        code, output = self.run_cached(tree, options, clang)
         self.assertIn(f"algo/unit.cpp: {status} (", output)
         self.assertEqual(code, 1 if status == "finding" else 0, output)
         return output
@@ -130,6 +145,34 @@ class ClangTidyCacheTest(unittest.TestCase):
         self.assertRegex(listed.read_text(), r"^[0-9a-f]{64} algo/unit.cpp\n$")
         self.assert_status("finding", other, ("--known-clean", str(listed)))
 
+    # The fake clang fails to preprocess: "cached" can only come from the dependency file's key.
+    def test_a_built_unit_is_keyed_by_the_files_it_read(self):
+        clang = self.clang_that_cannot_preprocess()
+        self.compile()
+        self.assert_status("clean", clang=clang)
+        self.assert_status("cached", clang=clang)
+        self.set_helper(SUPPRESSED_HELPER)
+        self.compile()
+        self.assert_status("clean", clang=clang)
+        self.assert_status("cached", clang=clang)
+        self.set_helper(CAST_HELPER)
+        self.compile()
+        self.assert_status("finding", clang=clang)
+        self.assert_status("finding", clang=clang)
+
+    # Edited since the build, the unit includes a file its dependency file does not list: a key
+    # from the list would not see that file change.
+    def test_a_unit_edited_after_the_build_is_preprocessed(self):
+        self.compile()
+        unit = self.tree / "algo" / "unit.cpp"
+        other = self.tree / "algo" / "other.hpp"
+        other.write_text(CLEAN_HELPER.replace("helper", "other"))
+        unit.write_text('#include "other.hpp"\n' + UNIT)
+        later = (self.tree / "build" / "unit.o.d").stat().st_mtime_ns + 1_000_000_000
+        os.utime(unit, ns=(later, later))
+        self.assert_status("clean")
+        other.write_text(CAST_HELPER.replace("helper", "other"))
+        self.assert_status("finding")
 
 if __name__ == "__main__":
     if len(sys.argv) != 4:
