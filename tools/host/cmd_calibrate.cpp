@@ -44,7 +44,7 @@ struct CalibrateOptions {
   double spanDeg = 80.0;
 };
 
-int fail(const CliStreams& io, int code, const std::string& message) {
+int calibrationFailed(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux calibrate: " << message << "\n";
   return code;
 }
@@ -53,33 +53,33 @@ int fail(const CliStreams& io, int code, const std::string& message) {
 int solveAndWrite(const algo::Rig& nominal, const CalibrateOptions& opts, const CliStreams& io) {
   const fs::path outFile = opts.out.filename();
   if (const auto problem = fileNameProblem(outFile.string())) {
-    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+    return calibrationFailed(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
   }
   // A failed solve leaves an earlier rig and report as they were.
   const std::string untouched = "; nothing written (" + opts.out.string() +
                                 (opts.report ? ", " + opts.report->string() : "") + ")";
   auto calibration = calib::calibrate(nominal, opts.captures);
   if (!calibration) {
-    return fail(io, kExitBadInput, calibration.error() + untouched);
+    return calibrationFailed(io, kExitBadInput, calibration.error() + untouched);
   }
   if (auto valid = config::validateRig(calibration->rig); !valid) {
-    return fail(
+    return calibrationFailed(
         io, kExitBadInput,
         "the solve failed: the solved rig is not valid: " + valid.error().message() + untouched);
   }
   const std::string text = calib::reportText(*calibration);
   auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");
   if (!rigDir) {
-    return fail(io, kExitDeviceOrIo, rigDir.error());
+    return calibrationFailed(io, kExitDeviceOrIo, rigDir.error());
   }
   if (auto ok = rigDir->writeText(outFile.string(), config::toJson(calibration->rig)); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return calibrationFailed(io, kExitDeviceOrIo, ok.error());
   }
   std::optional<OutputFolder> reportDir;
   if (opts.report) {
     auto dir = OutputFolder::create(*opts.report);
     if (!dir) {
-      return fail(io, kExitDeviceOrIo, dir.error());
+      return calibrationFailed(io, kExitDeviceOrIo, dir.error());
     }
     reportDir.emplace(std::move(*dir));
     for (const auto& [name, body] :
@@ -87,15 +87,15 @@ int solveAndWrite(const algo::Rig& nominal, const CalibrateOptions& opts, const 
                                               calib::reportJson(*calibration).dump(2) + "\n"},
           {"summary.txt", text}}) {
       if (auto ok = reportDir->writeText(name, body); !ok) {
-        return fail(io, kExitDeviceOrIo, ok.error());
+        return calibrationFailed(io, kExitDeviceOrIo, ok.error());
       }
     }
   }
   if (auto ok = reportDir ? reportDir->commit() : std::expected<void, std::string>{}; !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return calibrationFailed(io, kExitDeviceOrIo, ok.error());
   }
   if (auto ok = rigDir->commit(); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return calibrationFailed(io, kExitDeviceOrIo, ok.error());
   }
   io.out << text << "wrote " << opts.out.string() << "\n";
   return kExitOk;
@@ -104,7 +104,7 @@ int solveAndWrite(const algo::Rig& nominal, const CalibrateOptions& opts, const 
 int runCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
   const auto nominal = config::loadRig(opts.rig);
   if (!nominal) {
-    return fail(io, kExitBadInput, nominal.error().message());
+    return calibrationFailed(io, kExitBadInput, nominal.error().message());
   }
   return solveAndWrite(*nominal, opts, io);
 }
@@ -115,7 +115,7 @@ int solveTableAndWrite(algo::Rig rig, const CalibrateOptions& opts, const CliStr
   const std::string untouched = "; nothing written (" + opts.out.string() + ")";
   auto table = calib::calibrateTable(rig, opts.captures);
   if (!table) {
-    return fail(io, kExitBadInput, table.error() + untouched);
+    return calibrationFailed(io, kExitBadInput, table.error() + untouched);
   }
   const auto& axis = table->axis;
   rig.turntable =
@@ -123,13 +123,13 @@ int solveTableAndWrite(algo::Rig rig, const CalibrateOptions& opts, const CliStr
                           .point = {axis.point.x(), axis.point.y(), axis.point.z()}};
   auto rigDir = OutputFolder::create(opts.out.has_parent_path() ? opts.out.parent_path() : ".");
   if (!rigDir) {
-    return fail(io, kExitDeviceOrIo, rigDir.error());
+    return calibrationFailed(io, kExitDeviceOrIo, rigDir.error());
   }
   if (auto ok = rigDir->writeText(outFile.string(), config::toJson(rig)); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return calibrationFailed(io, kExitDeviceOrIo, ok.error());
   }
   if (auto ok = rigDir->commit(); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return calibrationFailed(io, kExitDeviceOrIo, ok.error());
   }
   io.out << calib::tableReportText(*table) << "wrote " << opts.out.string() << "\n";
   return kExitOk;
@@ -137,12 +137,12 @@ int solveTableAndWrite(algo::Rig rig, const CalibrateOptions& opts, const CliStr
 
 int runTableCalibrate(const CalibrateOptions& opts, const CliStreams& io) {
   if (const auto problem = fileNameProblem(opts.out.filename().string())) {
-    return fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
+    return calibrationFailed(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem);
   }
   auto rig = config::loadRig(opts.rig);
   if (!rig) {
-    return fail(io, kExitBadInput,
-                rig.error().message() + "; nothing written (" + opts.out.string() + ")");
+    return calibrationFailed(
+        io, kExitBadInput, rig.error().message() + "; nothing written (" + opts.out.string() + ")");
   }
   return solveTableAndWrite(std::move(*rig), opts, io);
 }
@@ -173,11 +173,12 @@ std::expected<std::tuple<int, int, double>, int> checkBeforeCapture(CalibrateOpt
                                                                     const std::string& first,
                                                                     const CliStreams& io) {
   if (const auto problem = fileNameProblem(opts.out.filename().string())) {
-    return std::unexpected(fail(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem));
+    return std::unexpected(
+        calibrationFailed(io, kExitUsage, "--out " + opts.out.string() + ": " + *problem));
   }
   const auto target = givenTarget(opts);
   if (!target) {
-    return std::unexpected(fail(io, kExitUsage, target.error()));
+    return std::unexpected(calibrationFailed(io, kExitUsage, target.error()));
   }
   if (opts.captures.empty()) {
     opts.captures = defaultCaptures(opts.out);
@@ -185,15 +186,17 @@ std::expected<std::tuple<int, int, double>, int> checkBeforeCapture(CalibrateOpt
   // Captures of an earlier session beside new ones would be solved as one set.
   std::error_code ec;
   if (fs::exists(opts.captures / first, ec)) {
-    return std::unexpected(fail(io, kExitUsage,
-                                opts.captures.string() + " already holds captures (" + first +
-                                    "/): give another --captures or remove them"));
+    return std::unexpected(calibrationFailed(io, kExitUsage,
+                                             opts.captures.string() + " already holds captures (" +
+                                                 first +
+                                                 "/): give another --captures or remove them"));
   }
   const auto& [cols, rows, squareM] = *target;
   if ((cols == 0 || squareM == 0) && !fs::exists(opts.captures / "target.json", ec)) {
-    return std::unexpected(fail(io, kExitUsage,
-                                "no target: give --target COLSxROWS and --square M, or write " +
-                                    (opts.captures / "target.json").string()));
+    return std::unexpected(
+        calibrationFailed(io, kExitUsage,
+                          "no target: give --target COLSxROWS and --square M, or write " +
+                              (opts.captures / "target.json").string()));
   }
   return *target;
 }
@@ -211,15 +214,15 @@ int runDeviceTableCalibrate(CalibrateOptions opts, const CliStreams& io) {
   std::tie(capture.cols, capture.rows, capture.squareM) = *target;
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return fail(io, kExitDeviceOrIo, client.error());
+    return calibrationFailed(io, kExitDeviceOrIo, client.error());
   }
   algo::Rig rig = client->info().rig;
   const auto captured = captureTableSet(*client, rig, capture, opts.captures, io);
   client->close();
   if (!captured) {
     const bool noTable = captured.error().starts_with("the device has no turntable");
-    return fail(io, noTable ? kExitBadInput : kExitDeviceOrIo,
-                captured.error() + "; nothing written (" + opts.out.string() + ")");
+    return calibrationFailed(io, noTable ? kExitBadInput : kExitDeviceOrIo,
+                             captured.error() + "; nothing written (" + opts.out.string() + ")");
   }
   return solveTableAndWrite(std::move(rig), opts, io);
 }
@@ -235,13 +238,13 @@ int runDeviceCalibrate(CalibrateOptions opts, const CliStreams& io) {
   std::tie(guide.cols, guide.rows, guide.squareM) = *target;
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return fail(io, kExitDeviceOrIo, client.error());
+    return calibrationFailed(io, kExitDeviceOrIo, client.error());
   }
   const algo::Rig nominal = client->info().rig;
   const auto captured = captureCalibrationSet(*client, nominal, guide, opts.captures, io);
   client->close();
   if (!captured) {
-    return fail(io, kExitDeviceOrIo, captured.error());
+    return calibrationFailed(io, kExitDeviceOrIo, captured.error());
   }
   return solveAndWrite(nominal, opts, io);
 }
@@ -300,15 +303,17 @@ void addCalibrateCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
       exitCode = runDeviceTableCalibrate(*opts, io);
     } else if (opts->turntable) {
       exitCode = rig->count() == 0 || captures->count() == 0
-                     ? fail(io, kExitUsage,
-                            "--turntable needs --rig (calibrated) and --captures, or --device")
+                     ? calibrationFailed(
+                           io, kExitUsage,
+                           "--turntable needs --rig (calibrated) and --captures, or --device")
                      : runTableCalibrate(*opts, io);
     } else if (device->count() > 0) {
       exitCode = runDeviceCalibrate(*opts, io);
     } else if (rig->count() == 0 || captures->count() == 0) {
-      exitCode = fail(io, kExitUsage,
-                      "give --rig and --captures (captures taken before), or --device (capture "
-                      "there first)");
+      exitCode = calibrationFailed(
+          io, kExitUsage,
+          "give --rig and --captures (captures taken before), or --device (capture "
+          "there first)");
     } else {
       exitCode = runCalibrate(*opts, io);
     }

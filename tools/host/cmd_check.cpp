@@ -22,7 +22,7 @@ namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 
 // The check ran and a projector is not good (docs/cli.md).
 constexpr int kExitNotHealthy = 4;
@@ -43,19 +43,19 @@ const char* kindName(health::Comparison::Kind kind) {
   return kind == health::Comparison::Kind::kProjectorPair ? "projector_pair" : "camera_pair";
 }
 
-Json toJson(const algo::Rig& rig, const health::CheckReport& report) {
-  Json projectors = Json::array();
+OrderedJson toJson(const algo::Rig& rig, const health::CheckReport& report) {
+  OrderedJson projectors = OrderedJson::array();
   for (const auto& h : report.projectors) {
     projectors.push_back({{"id", h.id},
                           {"verdict", health::verdictName(h.verdict)},
                           {"disagreement_mm", h.disagreementMm},
                           {"reason", h.reason}});
   }
-  Json comparisons = Json::array();
+  OrderedJson comparisons = OrderedJson::array();
   for (const auto& c : report.comparisons) {
     const auto& d = c.disagreement;
-    Json j = {{"kind", kindName(c.kind)},
-              {"camera", rig.cameras[static_cast<std::size_t>(c.camera)].id}};
+    OrderedJson j = {{"kind", kindName(c.kind)},
+                     {"camera", rig.cameras[static_cast<std::size_t>(c.camera)].id}};
     if (c.kind == health::Comparison::Kind::kProjectorPair) {
       j["projectors"] = {rig.projectors[static_cast<std::size_t>(c.projector)].id,
                          rig.projectors[static_cast<std::size_t>(c.otherProjector)].id};
@@ -102,7 +102,7 @@ std::string toText(const health::CheckReport& report) {
   return s.str();
 }
 
-int fail(const CliStreams& io, int code, const std::string& message) {
+int checkFailed(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux check: " << message << "\n";
   return code;
 }
@@ -113,23 +113,24 @@ int checkAndReport(const algo::Rig& rig, const std::string& rigName,
                    const CliStreams& io) {
   const auto report = health::checkRig(rig, frames);
   if (!report) {
-    return fail(io, kExitBadInput, rigName + ": " + report.error());
+    return checkFailed(io, kExitBadInput, rigName + ": " + report.error());
   }
-  const Json json = toJson(rig, *report);
-  const std::string jsonText = json.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+  const OrderedJson json = toJson(rig, *report);
+  const std::string jsonText =
+      json.dump(2, ' ', false, OrderedJson::error_handler_t::replace) + "\n";
   if (opts.report) {
     auto out = OutputFolder::create(*opts.report);
     if (!out) {
-      return fail(io, kExitDeviceOrIo, out.error());
+      return checkFailed(io, kExitDeviceOrIo, out.error());
     }
     if (auto ok = out->writeText("check.json", jsonText); !ok) {
-      return fail(io, kExitDeviceOrIo, ok.error());
+      return checkFailed(io, kExitDeviceOrIo, ok.error());
     }
     if (auto ok = out->writeText("check.txt", toText(*report)); !ok) {
-      return fail(io, kExitDeviceOrIo, ok.error());
+      return checkFailed(io, kExitDeviceOrIo, ok.error());
     }
     if (auto ok = out->commit(); !ok) {
-      return fail(io, kExitDeviceOrIo, ok.error());
+      return checkFailed(io, kExitDeviceOrIo, ok.error());
     }
   }
   io.out << (opts.json ? jsonText : toText(*report));
@@ -140,7 +141,7 @@ int runCheck(const CheckOptions& opts, const CliStreams& io) {
   // One image per camera that has one in the folder; loadRigAndImages checks the rig and them.
   auto rigOnly = loadRigAndImages(opts.rig, {});
   if (!rigOnly) {
-    return fail(io, kExitBadInput, rigOnly.error());
+    return checkFailed(io, kExitBadInput, rigOnly.error());
   }
   std::vector<std::string> specs;
   for (const auto& camera : rigOnly->rig.cameras) {
@@ -151,22 +152,22 @@ int runCheck(const CheckOptions& opts, const CliStreams& io) {
     }
   }
   if (specs.empty()) {
-    return fail(io, kExitBadInput,
-                opts.images.string() + ": no camera image (expected " +
-                    rigOnly->rig.cameras.front().id + ".png and one per camera)");
+    return checkFailed(io, kExitBadInput,
+                       opts.images.string() + ": no camera image (expected " +
+                           rigOnly->rig.cameras.front().id + ".png and one per camera)");
   }
   const auto loaded = loadRigAndImages(opts.rig, specs);
   if (!loaded) {
-    return fail(io, kExitBadInput, loaded.error());
+    return checkFailed(io, kExitBadInput, loaded.error());
   }
   std::vector<sim::RgbImage> images;
   for (const CameraImage& input : loaded->images) {
     auto image = readCameraImage(input.file, loaded->rig.cameras[input.camera]);
     if (!image) {
-      return fail(io, kExitBadInput, image.error());
+      return checkFailed(io, kExitBadInput, image.error());
     }
     if (auto colour = checkHasColour(input.file, *image); !colour) {
-      return fail(io, kExitBadInput, colour.error());
+      return checkFailed(io, kExitBadInput, colour.error());
     }
     images.push_back(std::move(*image));
   }
@@ -181,18 +182,19 @@ int runCheck(const CheckOptions& opts, const CliStreams& io) {
 int runDeviceCheck(const CheckOptions& opts, const CliStreams& io) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return fail(io, kExitDeviceOrIo, client.error());
+    return checkFailed(io, kExitDeviceOrIo, client.error());
   }
   const algo::Rig& rig = client->info().rig;
   const std::string rigName = client->info().address + ": the device's rig";
   if (rig.cameras.empty() || rig.projectors.empty() || rig.projectors.size() > 32) {
-    return fail(io, kExitBadInput, rigName + ": the check needs a camera and 1 to 32 projectors");
+    return checkFailed(io, kExitBadInput,
+                       rigName + ": the check needs a camera and 1 to 32 projectors");
   }
   const std::uint32_t all = rig.projectors.size() == 32 ? ~0U : (1U << rig.projectors.size()) - 1U;
   const auto capture = client->captureRaw(all, kCaptureTimeout);
   client->close();
   if (!capture) {
-    return fail(io, kExitDeviceOrIo, client->info().address + ": " + capture.error());
+    return checkFailed(io, kExitDeviceOrIo, client->info().address + ": " + capture.error());
   }
   std::vector<health::CameraFrame> frames;
   for (std::size_t c = 0; c < rig.cameras.size() && c < capture->images.size(); ++c) {
@@ -200,11 +202,11 @@ int runDeviceCheck(const CheckOptions& opts, const CliStreams& io) {
     const auto view =
         algo::ConstRgbView::packed(capture->images[c], capture->width, capture->height);
     if (!view || capture->width != camera.width || capture->height != camera.height) {
-      return fail(io, kExitDeviceOrIo,
-                  client->info().address + ": " + camera.id + " sent " +
-                      std::to_string(capture->width) + "x" + std::to_string(capture->height) +
-                      ", its rig says " + std::to_string(camera.width) + "x" +
-                      std::to_string(camera.height));
+      return checkFailed(io, kExitDeviceOrIo,
+                         client->info().address + ": " + camera.id + " sent " +
+                             std::to_string(capture->width) + "x" +
+                             std::to_string(capture->height) + ", its rig says " +
+                             std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
     frames.push_back({c, *view});
   }
@@ -231,7 +233,7 @@ void addCheckCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
     if (device->count() > 0) {
       exitCode = runDeviceCheck(*opts, io);
     } else if (rig->count() == 0 || images->count() == 0) {
-      exitCode = fail(io, kExitUsage, "give --rig and --images, or --device");
+      exitCode = checkFailed(io, kExitUsage, "give --rig and --images, or --device");
     } else {
       exitCode = runCheck(*opts, io);
     }

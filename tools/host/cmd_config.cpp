@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr auto kAnswerTimeout = std::chrono::milliseconds(10000);
+constexpr auto kConfigAnswerTimeout = std::chrono::milliseconds(10000);
 
 struct ConfigOptions {
   std::string device;
@@ -112,7 +112,7 @@ Result runGet(const ConfigOptions& opts) {
     return std::unexpected(Failure{kExitUsage, "get: no setting \"" + printable(opts.key) +
                                                    "\"; settings: " + settingKeysList()});
   }
-  auto json = connectAnd(opts, [](DeviceClient& c) { return c.getConfig(kAnswerTimeout); });
+  auto json = connectAnd(opts, [](DeviceClient& c) { return c.getConfig(kConfigAnswerTimeout); });
   if (!json || opts.key.empty()) {
     return json;
   }
@@ -127,8 +127,8 @@ Result runGet(const ConfigOptions& opts) {
 
 Result runChange(const ConfigOptions& opts, protocol::SetConfigMode mode,
                  const std::string& change) {
-  auto json =
-      connectAnd(opts, [&](DeviceClient& c) { return c.setConfig(mode, change, kAnswerTimeout); });
+  auto json = connectAnd(
+      opts, [&](DeviceClient& c) { return c.setConfig(mode, change, kConfigAnswerTimeout); });
   if (!json) {
     return json;
   }

@@ -27,7 +27,7 @@ namespace smx::host {
 namespace {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 
 struct DecodeOptions {
   fs::path rig;
@@ -39,7 +39,7 @@ struct DecodeOptions {
 };
 
 // A failure with its exit code and message.
-struct Failure {
+struct DecodeFailure {
   int code;
   std::string message;
 };
@@ -65,15 +65,16 @@ std::string depthUnitProblem(const DecodeOptions& opts) {
   return s.str();
 }
 
-std::expected<void, Failure> writeOrFail(const std::expected<void, std::string>& written) {
+std::expected<void, DecodeFailure> writeOrFail(const std::expected<void, std::string>& written) {
   if (!written) {
-    return std::unexpected(Failure{kExitDeviceOrIo, written.error()});
+    return std::unexpected(DecodeFailure{kExitDeviceOrIo, written.error()});
   }
   return {};
 }
 
-std::expected<void, Failure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
-                                        const algo::Rig& rig, algo::CameraPipeline& pipeline) {
+std::expected<void, DecodeFailure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
+                                              const algo::Rig& rig,
+                                              algo::CameraPipeline& pipeline) {
   for (int p = 0; p < pipeline.projectors(); ++p) {
     const std::string tag = rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id;
     if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
@@ -102,38 +103,38 @@ struct Outputs {
 
 // Runs one camera's image through the pipeline, writes its files, and appends its meta.json entry
 // to `cameras` and its world points to `merged`.
-std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
-                                          const CameraImage& input, std::ostream& report,
-                                          Outputs& outputs, Json& cameras,
-                                          std::vector<sim::PlyPoint>& merged) {
+std::expected<void, DecodeFailure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
+                                                const CameraImage& input, std::ostream& report,
+                                                Outputs& outputs, OrderedJson& cameras,
+                                                std::vector<sim::PlyPoint>& merged) {
   const algo::Camera& camera = rig.cameras[input.camera];
   const auto image = readCameraImage(input.file, camera);
   if (!image) {
-    return std::unexpected(Failure{kExitBadInput, image.error()});
+    return std::unexpected(DecodeFailure{kExitBadInput, image.error()});
   }
   if (auto colour = checkHasColour(input.file, *image); !colour) {
-    return std::unexpected(Failure{kExitBadInput, colour.error()});
+    return std::unexpected(DecodeFailure{kExitBadInput, colour.error()});
   }
   algo::PipelineOptions options;
   options.nominalDepthM = opts.nominalDepthM;
   options.depthUnitM = opts.depthUnitM;
   const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(input.camera), options);
   if (!setup) {
-    return std::unexpected(Failure{kExitBadInput, opts.rig.string() + ": " + setup.error()});
+    return std::unexpected(DecodeFailure{kExitBadInput, opts.rig.string() + ": " + setup.error()});
   }
   const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
   if (!bytes) {
-    return std::unexpected(Failure{kExitBadInput, bytes.error().message});
+    return std::unexpected(DecodeFailure{kExitBadInput, bytes.error().message});
   }
   std::vector<std::byte> memory(*bytes);
   algo::Arena arena(memory);
   auto pipeline = algo::CameraPipeline::create(*setup, arena);
   if (!pipeline) {
-    return std::unexpected(Failure{kExitBadInput, pipeline.error().message});
+    return std::unexpected(DecodeFailure{kExitBadInput, pipeline.error().message});
   }
 
   // The stages one by one, timed.
-  Json timings = Json::object();
+  OrderedJson timings = OrderedJson::object();
   double totalMs = 0;
   const auto timed = [&](const char* name, auto&& stage) -> algo::Result<void> {
     const auto start = std::chrono::steady_clock::now();
@@ -149,11 +150,12 @@ std::expected<void, Failure> decodeCamera(const DecodeOptions& opts, const algo:
   ok = ok ? timed("triangulate", [&] { return pipeline->triangulate(); }) : ok;
   ok = ok ? timed("merge", [&] { return pipeline->merge(); }) : ok;
   if (!ok) {
-    return std::unexpected(Failure{kExitBadInput, input.file.string() + ": " + ok.error().message});
+    return std::unexpected(
+        DecodeFailure{kExitBadInput, input.file.string() + ": " + ok.error().message});
   }
   timings["total"] = totalMs;
 
-  Json pairs = Json::array();
+  OrderedJson pairs = OrderedJson::array();
   for (int p = 0; p < pipeline->projectors(); ++p) {
     const std::string name =
         rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id + ".depth.png";
@@ -234,7 +236,7 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
     }
     outputs.debug.emplace(std::move(*debug));
   }
-  Json cameras = Json::array();
+  OrderedJson cameras = OrderedJson::array();
   std::vector<sim::PlyPoint> merged;
   std::ostringstream report;
   for (const CameraImage& input : loaded->images) {
@@ -245,11 +247,11 @@ int runDecode(const DecodeOptions& opts, const CliStreams& io) {
   if (auto ok = writePlyPoints(outputs.out, "merged.ply", merged); !ok) {
     return fail(kExitDeviceOrIo, ok.error());
   }
-  const Json meta = {{"format", "stripemux-decode/1"}, {"depth_unit_m", opts.depthUnitM},
-                     {"rig", opts.rig.string()},       {"cameras", cameras},
-                     {"merged_ply", "merged.ply"},     {"merged_points", merged.size()}};
+  const OrderedJson meta = {{"format", "stripemux-decode/1"}, {"depth_unit_m", opts.depthUnitM},
+                            {"rig", opts.rig.string()},       {"cameras", cameras},
+                            {"merged_ply", "merged.ply"},     {"merged_points", merged.size()}};
   if (auto ok = outputs.out.writeText(
-          "meta.json", meta.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
+          "meta.json", meta.dump(2, ' ', false, OrderedJson::error_handler_t::replace) + "\n");
       !ok) {
     return fail(kExitDeviceOrIo, ok.error());
   }

@@ -20,7 +20,7 @@ namespace {
 
 // The device rolled back the update: it runs the firmware before (the reason is printed).
 constexpr int kExitRolledBack = 4;
-constexpr auto kAnswerTimeout = std::chrono::milliseconds(10000);
+constexpr auto kFlashAnswerTimeout = std::chrono::milliseconds(10000);
 // Verification and extraction of a bundle of the largest size on a slow SD card.
 constexpr auto kInstallTimeout = std::chrono::milliseconds(300'000);
 constexpr auto kRetryDelay = std::chrono::milliseconds(500);
@@ -32,7 +32,7 @@ struct FlashOptions {
   double waitS = 120;  // for the device to come back and settle
 };
 
-struct Failure {
+struct FlashFailure {
   int code;
   std::string message;
 };
@@ -65,7 +65,7 @@ void showSent(const CliStreams& io, bool tty, std::uint64_t sent, std::uint64_t 
 
 // The device's update status once it is back and settled (a trial decided), retrying the
 // connection while it restarts.
-std::expected<UpdateStatusReport, Failure> awaitSettled(const FlashOptions& opts) {
+std::expected<UpdateStatusReport, FlashFailure> awaitSettled(const FlashOptions& opts) {
   const auto deadline = std::chrono::steady_clock::now() + secondsOption(opts.waitS);
   std::string last = "no answer";
   while (std::chrono::steady_clock::now() < deadline) {
@@ -75,7 +75,7 @@ std::expected<UpdateStatusReport, Failure> awaitSettled(const FlashOptions& opts
       last = client.error();
       continue;
     }
-    auto status = client->updateStatus(kAnswerTimeout);
+    auto status = client->updateStatus(kFlashAnswerTimeout);
     if (!status) {
       last = status.error();
       continue;
@@ -85,34 +85,34 @@ std::expected<UpdateStatusReport, Failure> awaitSettled(const FlashOptions& opts
     }
     last = "the new firmware has not passed its self-test yet";
   }
-  return std::unexpected(Failure{kExitDeviceOrIo, "the device did not come back within " +
-                                                      std::to_string(static_cast<int>(opts.waitS)) +
-                                                      " s: " + last});
+  return std::unexpected(FlashFailure{
+      kExitDeviceOrIo, "the device did not come back within " +
+                           std::to_string(static_cast<int>(opts.waitS)) + " s: " + last});
 }
 
-std::expected<std::string, Failure> runStatus(const FlashOptions& opts) {
+std::expected<std::string, FlashFailure> runStatus(const FlashOptions& opts) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return std::unexpected(Failure{kExitDeviceOrIo, client.error()});
+    return std::unexpected(FlashFailure{kExitDeviceOrIo, client.error()});
   }
-  auto status = client->updateStatus(kAnswerTimeout);
+  auto status = client->updateStatus(kFlashAnswerTimeout);
   if (!status) {
-    return std::unexpected(Failure{kExitDeviceOrIo, status.error()});
+    return std::unexpected(FlashFailure{kExitDeviceOrIo, status.error()});
   }
   return describe(*status) + "\n";
 }
 
-std::expected<std::string, Failure> runFlash(const FlashOptions& opts, const CliStreams& io) {
+std::expected<std::string, FlashFailure> runFlash(const FlashOptions& opts, const CliStreams& io) {
   auto bytes = update::readFile(opts.file, update::kMaxBundleSize);
   if (!bytes) {
-    return std::unexpected(Failure{kExitBadInput, bytes.error().message});
+    return std::unexpected(FlashFailure{kExitBadInput, bytes.error().message});
   }
   if (auto shape = update::checkBundleShape(*bytes); !shape) {
-    return std::unexpected(Failure{kExitBadInput, opts.file + ": " + shape.error().message});
+    return std::unexpected(FlashFailure{kExitBadInput, opts.file + ": " + shape.error().message});
   }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return std::unexpected(Failure{kExitDeviceOrIo, client.error()});
+    return std::unexpected(FlashFailure{kExitDeviceOrIo, client.error()});
   }
   io.err << "flashing " << opts.file << " (" << bytes->size() << " bytes) to "
          << client->info().address << ", running " << printable(client->info().firmwareVersion)
@@ -124,8 +124,8 @@ std::expected<std::string, Failure> runFlash(const FlashOptions& opts, const Cli
       kInstallTimeout);
   client->close();
   if (!flashed) {
-    return std::unexpected(Failure{flashed.error().refused ? kExitBadInput : kExitDeviceOrIo,
-                                   flashed.error().message});
+    return std::unexpected(FlashFailure{flashed.error().refused ? kExitBadInput : kExitDeviceOrIo,
+                                        flashed.error().message});
   }
   io.err << "waiting for the device to restart\n";
   auto settled = awaitSettled(opts);
@@ -133,7 +133,7 @@ std::expected<std::string, Failure> runFlash(const FlashOptions& opts, const Cli
     return std::unexpected(settled.error());
   }
   if (settled->outcome == protocol::UpdateOutcomeCode::kRolledBack) {
-    return std::unexpected(Failure{kExitRolledBack, describe(*settled)});
+    return std::unexpected(FlashFailure{kExitRolledBack, describe(*settled)});
   }
   return describe(*settled) + "\n";
 }

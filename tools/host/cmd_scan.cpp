@@ -30,7 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int fail(const CliStreams& io, int code, const std::string& message) {
+int scanFailed(const CliStreams& io, int code, const std::string& message) {
   io.err << "stripemux scan: " << printable(message) << "\n";
   return code;
 }
@@ -93,7 +93,7 @@ int fuseForPage(const FuseFolderOptions& fuse, const CliStreams& io, LiveView* l
 int runTurntableScan(const ScanOptions& opts, const CliStreams& io, LiveView* live) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return fail(io, kExitDeviceOrIo, client.error());
+    return scanFailed(io, kExitDeviceOrIo, client.error());
   }
   const DeviceInfo& info = client->info();
   // A device without a table is told apart from a table without a calibrated axis: the advice
@@ -102,23 +102,23 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io, LiveView* li
       .views = opts.views, .colour = !opts.noColour, .frameTimeout = secondsOption(opts.timeoutS)};
   auto table = client->turntableStatus(capture.frameTimeout);
   if (!table && !table.error().absent) {
-    return fail(io, kExitDeviceOrIo, table.error().message);
+    return scanFailed(io, kExitDeviceOrIo, table.error().message);
   }
   if (!table || !table->present) {
-    return fail(io, kExitBadInput,
-                noTurntable(table ? "the device has no turntable" : table.error().message));
+    return scanFailed(io, kExitBadInput,
+                      noTurntable(table ? "the device has no turntable" : table.error().message));
   }
   if (!info.rig.turntable) {
-    return fail(io, kExitBadInput,
-                "the device's rig has no turntable axis: calibrate it (stripemux calibrate "
-                "--device " +
-                    printable(opts.device) +
-                    " --turntable --out RIG.json) and install the rig (stripemux config set "
-                    "rig=RIG.json)");
+    return scanFailed(io, kExitBadInput,
+                      "the device's rig has no turntable axis: calibrate it (stripemux calibrate "
+                      "--device " +
+                          printable(opts.device) +
+                          " --turntable --out RIG.json) and install the rig (stripemux config set "
+                          "rig=RIG.json)");
   }
   auto writer = ViewsWriter::create(opts.out, info.rig, info.rigJson, scan::ScanMode::kTurntable);
   if (!writer) {
-    return fail(io, kExitDeviceOrIo, writer.error());
+    return scanFailed(io, kExitDeviceOrIo, writer.error());
   }
   io.out << "connected to " << printable(info.address) << ": " << printable(info.board) << ", "
          << info.cameras << " cameras; " << opts.views << " views into "
@@ -165,11 +165,11 @@ int runTurntableScan(const ScanOptions& opts, const CliStreams& io, LiveView* li
       });
   if (!views) {
     const bool absent = views.error().starts_with("the device has no turntable");
-    return fail(io, absent ? kExitBadInput : kExitDeviceOrIo, views.error());
+    return scanFailed(io, absent ? kExitBadInput : kExitDeviceOrIo, views.error());
   }
   client->close();
   if (auto ok = writer->finish({}); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return scanFailed(io, kExitDeviceOrIo, ok.error());
   }
   const double captureS =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -218,16 +218,16 @@ view::SidesSeen sidesAround(const scan::Cloud& model, const std::vector<Eigen::V
 int runHandheldScan(const ScanOptions& opts, const CliStreams& io, LiveView* live) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return fail(io, kExitDeviceOrIo, client.error());
+    return scanFailed(io, kExitDeviceOrIo, client.error());
   }
   const DeviceInfo& info = client->info();
   auto tracker = scan::Tracker::create(info.rig);
   if (!tracker) {
-    return fail(io, kExitBadInput, tracker.error());
+    return scanFailed(io, kExitBadInput, tracker.error());
   }
   auto writer = ViewsWriter::create(opts.out, info.rig, info.rigJson, scan::ScanMode::kHandheld);
   if (!writer) {
-    return fail(io, kExitDeviceOrIo, writer.error());
+    return scanFailed(io, kExitDeviceOrIo, writer.error());
   }
   io.out << "connected to " << printable(info.address) << ": " << printable(info.board) << ", "
          << info.cameras << " cameras at " << info.fps << " fps; move round the object, "
@@ -305,11 +305,11 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io, LiveView* liv
       });
   std::signal(SIGINT, previous);
   if (!tally) {
-    return fail(io, kExitDeviceOrIo, tally.error());
+    return scanFailed(io, kExitDeviceOrIo, tally.error());
   }
   client->close();
   if (auto ok = writer->finish(poses); !ok) {
-    return fail(io, kExitDeviceOrIo, ok.error());
+    return scanFailed(io, kExitDeviceOrIo, ok.error());
   }
   const double trackMs = tally->captures > 0 ? tally->trackMsTotal / tally->captures : 0.0;
   io.out << text::printfText(
@@ -318,10 +318,11 @@ int runHandheldScan(const ScanOptions& opts, const CliStreams& io, LiveView* liv
       tally->captures, tally->fused, tally->lost, tally->relocalised, trackMs,
       static_cast<unsigned long long>(tally->device.framesDropped));
   if (tally->fused < 2) {
-    return fail(io, kExitBadInput,
-                "only " + std::to_string(tally->fused) +
-                    " captures tracked well enough to fuse: scan again, moving slowly over the "
-                    "object and keeping it in view");
+    return scanFailed(
+        io, kExitBadInput,
+        "only " + std::to_string(tally->fused) +
+            " captures tracked well enough to fuse: scan again, moving slowly over the "
+            "object and keeping it in view");
   }
   FuseFolderOptions fuse = opts.fuse;
   fuse.dir = opts.out.string();
@@ -376,7 +377,7 @@ void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
   addPageOptions(*cmd, *page, "--view-", viewFlag);
   cmd->callback([opts, liveView, page, &io, &exitCode] {
     if (!opts->turntable && !opts->handheld) {
-      exitCode = fail(io, kExitUsage, "give --turntable or --handheld");
+      exitCode = scanFailed(io, kExitUsage, "give --turntable or --handheld");
       return;
     }
     if (!*liveView) {
@@ -385,7 +386,7 @@ void addScanCommand(CLI::App& app, const CliStreams& io, int& exitCode) {
     }
     auto live = LiveView::start(*page);
     if (!live) {
-      exitCode = fail(io, kExitDeviceOrIo, live.error());
+      exitCode = scanFailed(io, kExitDeviceOrIo, live.error());
       return;
     }
     io.out << "live view: " << (*live)->url() << "\n" << std::flush;

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 constexpr auto kReconnectFor = std::chrono::seconds(20);
-constexpr auto kAnswerTimeout = std::chrono::seconds(5);
+constexpr auto kViewAnswerTimeout = std::chrono::seconds(5);
 
 struct ViewOptions {
   std::string device;
@@ -79,7 +79,7 @@ class Viewer {
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
     }
     live_.setDevice(client_->info(), kViewControls);
-    if (auto settings = client_->getConfig(kAnswerTimeout); settings) {
+    if (auto settings = client_->getConfig(kViewAnswerTimeout); settings) {
       live_.setSettings(*settings);
     }
     return streaming_ ? start() : std::expected<void, std::string>{};
@@ -189,7 +189,7 @@ class Viewer {
   // A change the device stores and restarts with; then the view reconnects.
   [[nodiscard]] std::expected<void, std::string> restartWith(const std::string& change,
                                                              const std::string& what) {
-    auto changed = client_->setConfig(protocol::SetConfigMode::kChange, change, kAnswerTimeout);
+    auto changed = client_->setConfig(protocol::SetConfigMode::kChange, change, kViewAnswerTimeout);
     if (!changed) {
       live_.setMessage(what + " refused: " + changed.error());
       live_.refresh();
