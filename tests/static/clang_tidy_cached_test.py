@@ -160,6 +160,14 @@ class ClangTidyCacheTest(unittest.TestCase):
         self.assert_status("finding", clang=clang)
         self.assert_status("finding", clang=clang)
 
+    def test_a_built_clone_at_another_path_shares_the_cache(self):
+        clang = self.clang_that_cannot_preprocess()
+        self.compile()
+        self.assert_status("clean", clang=clang)
+        other = self.make_tree(self.tmp / "clone-b")
+        self.compile(other)
+        self.assert_status("cached", other, clang=clang)
+
     # Edited since the build, the unit includes a file its dependency file does not list: a key
     # from the list would not see that file change.
     def test_a_unit_edited_after_the_build_is_preprocessed(self):
