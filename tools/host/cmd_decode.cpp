@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "camera_images.hpp"
+#include "command_failure.hpp"
 #include "commands.hpp"
 #include "decode_debug.hpp"
 #include "demux_debug.hpp"
@@ -39,11 +40,6 @@ struct DecodeOptions {
 };
 
 // A failure with its exit code and message.
-struct DecodeFailure {
-  int code;
-  std::string message;
-};
-
 int countValid(algo::ConstDepthPlane depth) {
   int n = 0;
   for (int y = 0; y < depth.height(); ++y) {
@@ -65,16 +61,16 @@ std::string depthUnitProblem(const DecodeOptions& opts) {
   return s.str();
 }
 
-std::expected<void, DecodeFailure> writeOrFail(const std::expected<void, std::string>& written) {
+std::expected<void, CommandFailure> writeOrFail(const std::expected<void, std::string>& written) {
   if (!written) {
-    return std::unexpected(DecodeFailure{kExitDeviceOrIo, written.error()});
+    return std::unexpected(CommandFailure{kExitDeviceOrIo, written.error()});
   }
   return {};
 }
 
-std::expected<void, DecodeFailure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
-                                              const algo::Rig& rig,
-                                              algo::CameraPipeline& pipeline) {
+std::expected<void, CommandFailure> writeDebug(OutputFolder& dir, const algo::Camera& camera,
+                                               const algo::Rig& rig,
+                                               algo::CameraPipeline& pipeline) {
   for (int p = 0; p < pipeline.projectors(); ++p) {
     const std::string tag = rig.projectors[static_cast<std::size_t>(p)].id + "." + camera.id;
     if (auto ok = writeOrFail(writeDemuxDebug(dir, tag, pipeline.demux(), p)); !ok) {
@@ -103,34 +99,34 @@ struct Outputs {
 
 // Runs one camera's image through the pipeline, writes its files, and appends its meta.json entry
 // to `cameras` and its world points to `merged`.
-std::expected<void, DecodeFailure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
-                                                const CameraImage& input, std::ostream& report,
-                                                Outputs& outputs, OrderedJson& cameras,
-                                                std::vector<sim::PlyPoint>& merged) {
+std::expected<void, CommandFailure> decodeCamera(const DecodeOptions& opts, const algo::Rig& rig,
+                                                 const CameraImage& input, std::ostream& report,
+                                                 Outputs& outputs, OrderedJson& cameras,
+                                                 std::vector<sim::PlyPoint>& merged) {
   const algo::Camera& camera = rig.cameras[input.camera];
   const auto image = readCameraImage(input.file, camera);
   if (!image) {
-    return std::unexpected(DecodeFailure{kExitBadInput, image.error()});
+    return std::unexpected(CommandFailure{kExitBadInput, image.error()});
   }
   if (auto colour = checkHasColour(input.file, *image); !colour) {
-    return std::unexpected(DecodeFailure{kExitBadInput, colour.error()});
+    return std::unexpected(CommandFailure{kExitBadInput, colour.error()});
   }
   algo::PipelineOptions options;
   options.nominalDepthM = opts.nominalDepthM;
   options.depthUnitM = opts.depthUnitM;
   const auto setup = algo::prepareCameraPipeline(rig, static_cast<int>(input.camera), options);
   if (!setup) {
-    return std::unexpected(DecodeFailure{kExitBadInput, opts.rig.string() + ": " + setup.error()});
+    return std::unexpected(CommandFailure{kExitBadInput, opts.rig.string() + ": " + setup.error()});
   }
   const auto bytes = algo::CameraPipeline::workspaceBytes(*setup);
   if (!bytes) {
-    return std::unexpected(DecodeFailure{kExitBadInput, bytes.error().message});
+    return std::unexpected(CommandFailure{kExitBadInput, bytes.error().message});
   }
   std::vector<std::byte> memory(*bytes);
   algo::Arena arena(memory);
   auto pipeline = algo::CameraPipeline::create(*setup, arena);
   if (!pipeline) {
-    return std::unexpected(DecodeFailure{kExitBadInput, pipeline.error().message});
+    return std::unexpected(CommandFailure{kExitBadInput, pipeline.error().message});
   }
 
   // The stages one by one, timed.
@@ -151,7 +147,7 @@ std::expected<void, DecodeFailure> decodeCamera(const DecodeOptions& opts, const
   ok = ok ? timed("merge", [&] { return pipeline->merge(); }) : ok;
   if (!ok) {
     return std::unexpected(
-        DecodeFailure{kExitBadInput, input.file.string() + ": " + ok.error().message});
+        CommandFailure{kExitBadInput, input.file.string() + ": " + ok.error().message});
   }
   timings["total"] = totalMs;
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "command_failure.hpp"
 #include "commands.hpp"
 #include "device_client.hpp"
 #include "device_option.hpp"
@@ -30,11 +31,6 @@ struct FlashOptions {
   std::string file;
   bool status = false;
   double waitS = 120;  // for the device to come back and settle
-};
-
-struct FlashFailure {
-  int code;
-  std::string message;
 };
 
 std::string describe(const UpdateStatusReport& s) {
@@ -65,7 +61,7 @@ void showSent(const CliStreams& io, bool tty, std::uint64_t sent, std::uint64_t 
 
 // The device's update status once it is back and settled (a trial decided), retrying the
 // connection while it restarts.
-std::expected<UpdateStatusReport, FlashFailure> awaitSettled(const FlashOptions& opts) {
+std::expected<UpdateStatusReport, CommandFailure> awaitSettled(const FlashOptions& opts) {
   const auto deadline = std::chrono::steady_clock::now() + secondsOption(opts.waitS);
   std::string last = "no answer";
   while (std::chrono::steady_clock::now() < deadline) {
@@ -85,34 +81,35 @@ std::expected<UpdateStatusReport, FlashFailure> awaitSettled(const FlashOptions&
     }
     last = "the new firmware has not passed its self-test yet";
   }
-  return std::unexpected(FlashFailure{
+  return std::unexpected(CommandFailure{
       kExitDeviceOrIo, "the device did not come back within " +
                            std::to_string(static_cast<int>(opts.waitS)) + " s: " + last});
 }
 
-std::expected<std::string, FlashFailure> runStatus(const FlashOptions& opts) {
+std::expected<std::string, CommandFailure> runStatus(const FlashOptions& opts) {
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return std::unexpected(FlashFailure{kExitDeviceOrIo, client.error()});
+    return std::unexpected(CommandFailure{kExitDeviceOrIo, client.error()});
   }
   auto status = client->updateStatus(kFlashAnswerTimeout);
   if (!status) {
-    return std::unexpected(FlashFailure{kExitDeviceOrIo, status.error()});
+    return std::unexpected(CommandFailure{kExitDeviceOrIo, status.error()});
   }
   return describe(*status) + "\n";
 }
 
-std::expected<std::string, FlashFailure> runFlash(const FlashOptions& opts, const CliStreams& io) {
+std::expected<std::string, CommandFailure> runFlash(const FlashOptions& opts,
+                                                    const CliStreams& io) {
   auto bytes = update::readFile(opts.file, update::kMaxBundleSize);
   if (!bytes) {
-    return std::unexpected(FlashFailure{kExitBadInput, bytes.error().message});
+    return std::unexpected(CommandFailure{kExitBadInput, bytes.error().message});
   }
   if (auto shape = update::checkBundleShape(*bytes); !shape) {
-    return std::unexpected(FlashFailure{kExitBadInput, opts.file + ": " + shape.error().message});
+    return std::unexpected(CommandFailure{kExitBadInput, opts.file + ": " + shape.error().message});
   }
   auto client = DeviceClient::connect(opts.device, kDeviceConnectTimeout);
   if (!client) {
-    return std::unexpected(FlashFailure{kExitDeviceOrIo, client.error()});
+    return std::unexpected(CommandFailure{kExitDeviceOrIo, client.error()});
   }
   io.err << "flashing " << opts.file << " (" << bytes->size() << " bytes) to "
          << client->info().address << ", running " << printable(client->info().firmwareVersion)
@@ -124,8 +121,8 @@ std::expected<std::string, FlashFailure> runFlash(const FlashOptions& opts, cons
       kInstallTimeout);
   client->close();
   if (!flashed) {
-    return std::unexpected(FlashFailure{flashed.error().refused ? kExitBadInput : kExitDeviceOrIo,
-                                        flashed.error().message});
+    return std::unexpected(CommandFailure{flashed.error().refused ? kExitBadInput : kExitDeviceOrIo,
+                                          flashed.error().message});
   }
   io.err << "waiting for the device to restart\n";
   auto settled = awaitSettled(opts);
@@ -133,7 +130,7 @@ std::expected<std::string, FlashFailure> runFlash(const FlashOptions& opts, cons
     return std::unexpected(settled.error());
   }
   if (settled->outcome == protocol::UpdateOutcomeCode::kRolledBack) {
-    return std::unexpected(FlashFailure{kExitRolledBack, describe(*settled)});
+    return std::unexpected(CommandFailure{kExitRolledBack, describe(*settled)});
   }
   return describe(*settled) + "\n";
 }

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "command_failure.hpp"
 #include "commands.hpp"
 #include "device_option.hpp"
 #include "device_socket.hpp"
@@ -21,11 +22,7 @@ namespace {
 
 using protocol::MessageType;
 
-struct PairFailure {
-  int exitCode;
-  std::string message;
-};
-using Fail = std::unexpected<PairFailure>;
+using Fail = std::unexpected<CommandFailure>;
 
 struct PairOptions {
   std::string device;
@@ -33,52 +30,52 @@ struct PairOptions {
   bool showKey = false;
 };
 
-std::expected<void, PairFailure> send(
+std::expected<void, CommandFailure> send(
     net::TcpClient& socket, const protocol::ProtocolResult<std::span<const std::byte>>& m) {
   if (!m) {
-    return Fail(PairFailure{kExitDeviceOrIo, m.error().message});
+    return Fail(CommandFailure{kExitDeviceOrIo, m.error().message});
   }
   if (auto sent = socket.sendAll(*m, kDeviceConnectTimeout); !sent) {
-    return Fail(PairFailure{kExitDeviceOrIo, sent.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, sent.error()});
   }
   return {};
 }
 
 // The device's answer of `expected` type; its error (code 5: a refusal of the pairing) otherwise.
-std::expected<std::vector<std::byte>, PairFailure> expect(net::TcpClient& socket,
-                                                          MessageType expected) {
+std::expected<std::vector<std::byte>, CommandFailure> expect(net::TcpClient& socket,
+                                                             MessageType expected) {
   auto answer = readClearMessage(socket, kDeviceConnectTimeout);
   if (!answer) {
-    return Fail(PairFailure{kExitDeviceOrIo, answer.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, answer.error()});
   }
   auto& [type, payload] = *answer;
   if (type == MessageType::kError) {
     const auto error = protocol::decodeError(payload);
     if (!error) {
-      return Fail(PairFailure{kExitDeviceOrIo, "the device refused (unreadable)"});
+      return Fail(CommandFailure{kExitDeviceOrIo, "the device refused (unreadable)"});
     }
     const bool refused = error->code == protocol::ErrorCode::kNotPaired;
-    return Fail(PairFailure{refused ? kExitBadInput : kExitDeviceOrIo,
-                            "the device refused: " + std::string(error->text)});
+    return Fail(CommandFailure{refused ? kExitBadInput : kExitDeviceOrIo,
+                               "the device refused: " + std::string(error->text)});
   }
   if (type != expected) {
-    return Fail(PairFailure{kExitDeviceOrIo,
-                            std::string("expected ") + protocol::toString(expected) + ", got " +
-                                protocol::toString(type) + " (does this firmware know pairing?)"});
+    return Fail(CommandFailure{
+        kExitDeviceOrIo, std::string("expected ") + protocol::toString(expected) + ", got " +
+                             protocol::toString(type) + " (does this firmware know pairing?)"});
   }
   return std::move(payload);
 }
 
-std::expected<net::TcpClient, PairFailure> open(const net::DeviceAddress& address) {
+std::expected<net::TcpClient, CommandFailure> open(const net::DeviceAddress& address) {
   auto socket = net::TcpClient::connect(address, kDeviceConnectTimeout);
   if (!socket) {
-    return Fail(PairFailure{kExitDeviceOrIo, socket.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, socket.error()});
   }
   return std::move(*socket);
 }
 
 // Asks the device to open a code (it prints it) and says how long it is valid.
-std::expected<protocol::PairReady, PairFailure> beginPairing(const net::DeviceAddress& address) {
+std::expected<protocol::PairReady, CommandFailure> beginPairing(const net::DeviceAddress& address) {
   auto socket = open(address);
   if (!socket) {
     return Fail(socket.error());
@@ -94,15 +91,15 @@ std::expected<protocol::PairReady, PairFailure> beginPairing(const net::DeviceAd
   const auto ready = protocol::decodePairReady(*payload);
   if (!ready) {
     return Fail(
-        PairFailure{kExitDeviceOrIo, std::string("bad pair-ready: ") + ready.error().message});
+        CommandFailure{kExitDeviceOrIo, std::string("bad pair-ready: ") + ready.error().message});
   }
   return *ready;
 }
 
 // The exchange proper; returns the device's key.
-std::expected<protocol::Key32, PairFailure> provePairing(const net::DeviceAddress& address,
-                                                         const protocol::KeyPair& identity,
-                                                         const std::string& code) {
+std::expected<protocol::Key32, CommandFailure> provePairing(const net::DeviceAddress& address,
+                                                            const protocol::KeyPair& identity,
+                                                            const std::string& code) {
   auto socket = open(address);
   if (!socket) {
     return Fail(socket.error());
@@ -119,13 +116,13 @@ std::expected<protocol::Key32, PairFailure> provePairing(const net::DeviceAddres
   }
   const auto challenge = protocol::decodePairChallenge(*payload);
   if (!challenge) {
-    return Fail(PairFailure{kExitDeviceOrIo,
-                            std::string("bad pair-challenge: ") + challenge.error().message});
+    return Fail(CommandFailure{kExitDeviceOrIo,
+                               std::string("bad pair-challenge: ") + challenge.error().message});
   }
   const auto keys = protocol::pakeFinish(share, challenge->element, request, challenge->element,
                                          challenge->identity);
   if (!keys) {
-    return Fail(PairFailure{kExitDeviceOrIo, "pair-challenge: an invalid element"});
+    return Fail(CommandFailure{kExitDeviceOrIo, "pair-challenge: an invalid element"});
   }
   const bool deviceKnowsCode = protocol::sameProof(challenge->proof, keys->deviceProof);
   // Sent either way, so that the device counts a wrong code at once and says what is left.
@@ -138,25 +135,25 @@ std::expected<protocol::Key32, PairFailure> provePairing(const net::DeviceAddres
     return Fail(done.error());
   }
   if (!deviceKnowsCode) {
-    return Fail(PairFailure{kExitBadInput, "the device did not prove the code: not paired"});
+    return Fail(CommandFailure{kExitBadInput, "the device did not prove the code: not paired"});
   }
   return challenge->identity;
 }
 
-std::expected<std::string, PairFailure> runPair(const PairOptions& opts) {
+std::expected<std::string, CommandFailure> runPair(const PairOptions& opts) {
   auto identity = hostIdentity();
   if (!identity) {
-    return Fail(PairFailure{kExitDeviceOrIo, identity.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, identity.error()});
   }
   if (opts.showKey) {
     return protocol::formatPublicKey(identity->publicKey, "stripemux-host");
   }
   if (opts.device.empty()) {
-    return Fail(PairFailure{kExitUsage, "--device HOST or --show-key is required"});
+    return Fail(CommandFailure{kExitUsage, "--device HOST or --show-key is required"});
   }
   const auto address = net::parseDeviceAddress(opts.device, protocol::kDefaultPort);
   if (!address) {
-    return Fail(PairFailure{kExitUsage, "--device: " + address.error()});
+    return Fail(CommandFailure{kExitUsage, "--device: " + address.error()});
   }
   const auto ready = beginPairing(*address);
   if (!ready) {
@@ -171,7 +168,7 @@ std::expected<std::string, PairFailure> runPair(const PairOptions& opts) {
   }
   if (code.size() < 6 || code.size() > 8 ||
       code.find_first_not_of("0123456789") != std::string::npos) {
-    return Fail(PairFailure{kExitUsage, "the pairing code is 6 to 8 digits"});
+    return Fail(CommandFailure{kExitUsage, "the pairing code is 6 to 8 digits"});
   }
   const auto deviceKey = provePairing(*address, *identity, code);
   if (!deviceKey) {
@@ -179,35 +176,35 @@ std::expected<std::string, PairFailure> runPair(const PairOptions& opts) {
   }
   const auto stored = storePairedDevice(*address, *deviceKey);
   if (!stored) {
-    return Fail(PairFailure{kExitDeviceOrIo, stored.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, stored.error()});
   }
   return "paired with " + net::toString(*address) + ": device key " +
          protocol::fingerprint(*deviceKey) + ", this host's key " +
          protocol::fingerprint(identity->publicKey) + " (" + stored->string() + ")\n";
 }
 
-std::expected<std::string, PairFailure> runUnpair(const std::string& device) {
+std::expected<std::string, CommandFailure> runUnpair(const std::string& device) {
   const auto address = net::parseDeviceAddress(device, protocol::kDefaultPort);
   if (!address) {
-    return Fail(PairFailure{kExitUsage, "--device: " + address.error()});
+    return Fail(CommandFailure{kExitUsage, "--device: " + address.error()});
   }
   const auto forgot = forgetPairedDevice(*address);
   if (!forgot) {
-    return Fail(PairFailure{kExitDeviceOrIo, forgot.error()});
+    return Fail(CommandFailure{kExitDeviceOrIo, forgot.error()});
   }
   if (!*forgot) {
     return Fail(
-        PairFailure{kExitBadInput, "this host has not paired with " + net::toString(*address)});
+        CommandFailure{kExitBadInput, "this host has not paired with " + net::toString(*address)});
   }
   return "forgot " + net::toString(*address) +
          "; the device keeps this host's key until its owner removes it from STATE/hosts\n";
 }
 
-int report(const std::expected<std::string, PairFailure>& result, const CliStreams& io,
+int report(const std::expected<std::string, CommandFailure>& result, const CliStreams& io,
            const char* command) {
   if (!result) {
     io.err << "stripemux " << command << ": " << result.error().message << "\n";
-    return result.error().exitCode;
+    return result.error().code;
   }
   io.out << *result;
   return kExitOk;
